@@ -1,0 +1,132 @@
+//! Errors raised by the engine: every refused value names the parameter, the
+//! value and the range it must lie in.
+
+use std::fmt;
+
+/// An error from building or running a model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// A parameter outside its physical range.
+    Parameter {
+        /// Parameter name, in the words of the seed (e.g. `track.pad.stiffness`).
+        name: String,
+        /// The value given.
+        value: f64,
+        /// The allowed range, in words (e.g. `> 0 N/m`).
+        allowed: String,
+    },
+    /// The time step breaks the stability limit of the explicit scheme.
+    UnstableTimeStep {
+        /// Requested step (s).
+        dt: f64,
+        /// Critical step computed from the parameters (s).
+        critical: f64,
+        /// Which part of the model sets the limit.
+        limit: String,
+    },
+    /// A wheel reached (or started outside) the fixed ends of the track.
+    OffTrack {
+        /// Wheel position along the track (m).
+        position: f64,
+        /// Track length (m).
+        length: f64,
+        /// Simulation time (s).
+        time: f64,
+    },
+    /// A state became non-finite during the run.
+    NonFinite {
+        /// Which quantity.
+        what: String,
+        /// Simulation time (s).
+        time: f64,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Parameter {
+                name,
+                value,
+                allowed,
+            } => write!(
+                f,
+                "parameter `{name}` = {value} is out of range: allowed {allowed}"
+            ),
+            Error::UnstableTimeStep {
+                dt,
+                critical,
+                limit,
+            } => write!(
+                f,
+                "time step dt = {dt:e} s exceeds the critical step {critical:e} s of the explicit \
+                 central-difference scheme (limit set by {limit}); use dt <= {critical:e} s"
+            ),
+            Error::OffTrack {
+                position,
+                length,
+                time,
+            } => write!(
+                f,
+                "wheel at position {position} m is outside the track (0, {length}) m at t = {time} s: \
+                 lengthen the track, shorten the run or move the start position"
+            ),
+            Error::NonFinite { what, time } => {
+                write!(f, "{what} became non-finite at t = {time} s")
+            }
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Result alias for the engine.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Checks `value > 0` and finite.
+pub fn positive(name: &str, value: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::Parameter {
+            name: name.into(),
+            value,
+            allowed: format!("finite and > 0 {unit}"),
+        })
+    }
+}
+
+/// Checks `value >= 0` and finite.
+pub fn non_negative(name: &str, value: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::Parameter {
+            name: name.into(),
+            value,
+            allowed: format!("finite and >= 0 {unit}"),
+        })
+    }
+}
+
+/// Checks that `value` is finite.
+pub fn finite(name: &str, value: f64, unit: &str) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::Parameter {
+            name: name.into(),
+            value,
+            allowed: format!("a finite number ({unit})"),
+        })
+    }
+}
+
+/// Builds a parameter error.
+pub fn out_of_range(name: &str, value: f64, allowed: impl Into<String>) -> Error {
+    Error::Parameter {
+        name: name.into(),
+        value,
+        allowed: allowed.into(),
+    }
+}

@@ -1,0 +1,17 @@
+//! # wheelflat
+//!
+//! Wheel-flat impact loads in railway vehicle-track dynamics: the coupled model of
+//! the seed thesis (adaptive radial-spring contact, two Timoshenko rails on discrete
+//! sleepers, six-degree-of-freedom roll-plane vehicle, central finite differences)
+//! as a pure Rust library. See `../shared/MODEL.md` for conventions.
+//!
+//! Modules, bottom up: [`profile`] (wheel radius with flats), [`contact`] (normal
+//! contact laws), [`track`] (rails, pads, sleepers, ballast), [`vehicle`] (roll-plane
+//! vehicle and the alternative loads), [`solver`] (the coupled time stepping),
+//! [`params`] (the seed's parameter sets).
+
+pub mod contact;
+pub mod error;
+pub mod profile;
+
+pub use error::{Error, Result};
