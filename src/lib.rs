@@ -13,5 +13,6 @@
 pub mod contact;
 pub mod error;
 pub mod profile;
+pub mod track;
 
 pub use error::{Error, Result};
