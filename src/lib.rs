@@ -14,5 +14,6 @@ pub mod contact;
 pub mod error;
 pub mod profile;
 pub mod track;
+pub mod vehicle;
 
 pub use error::{Error, Result};
