@@ -95,8 +95,7 @@ pub fn sin_minus_x_cos(a: f64) -> f64 {
         // a^3/3 - a^5/30 + a^7/840 - a^9/45360 + a^11/3991680
         a * a2
             * (1.0 / 3.0
-                + a2 * (-1.0 / 30.0
-                    + a2 * (1.0 / 840.0 + a2 * (-1.0 / 45360.0 + a2 / 3991680.0))))
+                + a2 * (-1.0 / 30.0 + a2 * (1.0 / 840.0 + a2 * (-1.0 / 45360.0 + a2 / 3991680.0))))
     } else {
         a.sin() - a * a.cos()
     }
@@ -442,11 +441,17 @@ mod tests {
         for delta in [1e-7, 1e-6, 3e-5, 1e-4, 5e-4, 2e-3] {
             let closed = perfect_wheel_force(KW, R, delta);
             let num = adaptive_numeric(KW, &w, 0.0, delta).force;
-            let fast = ContactLaw::adaptive(KW).unwrap().evaluate(&w, 0.0, delta).force;
+            let fast = ContactLaw::adaptive(KW)
+                .unwrap()
+                .evaluate(&w, 0.0, delta)
+                .force;
             // Independent form of (2.5) with the textbook acos.
             let a = ((R - delta) / R).acos();
             let textbook = 2.0 * KW * R * (a.sin() - a * a.cos());
-            assert!(((num - closed) / closed).abs() < 1e-9, "{delta}: {num} vs {closed}");
+            assert!(
+                ((num - closed) / closed).abs() < 1e-9,
+                "{delta}: {num} vs {closed}"
+            );
             assert_eq!(fast, closed);
             assert!(((textbook - closed) / closed).abs() < 1e-6);
         }
@@ -482,7 +487,12 @@ mod tests {
         let st = law.evaluate(&w, 0.0, delta);
         assert_eq!(st.intervals, 2, "{st:?}");
         let bf = brute_force(KW, &w, 0.0, delta, 100_000);
-        assert!(((st.force - bf) / bf).abs() < 1e-6, "{} vs {}", st.force, bf);
+        assert!(
+            ((st.force - bf) / bf).abs() < 1e-6,
+            "{} vs {}",
+            st.force,
+            bf
+        );
         // The patch keeps its perfect-wheel ends.
         let aw = patch_angle(delta, R);
         assert!((st.front_angle - aw).abs() < 1e-12 && (st.rear_angle + aw).abs() < 1e-12);
@@ -493,7 +503,13 @@ mod tests {
     fn partial_and_asymmetric_contact_match_brute_force() {
         let w = WheelProfile::new(R, &[FlatSpec::haversine(0.1, 0.0015, 0.0)], "f").unwrap();
         let law = ContactLaw::adaptive(KW).unwrap();
-        for (gamma, delta) in [(-0.09, 2e-4), (-0.1, 1e-3), (0.05, 1.6e-3), (0.0, 1.8e-3), (0.11, 3e-4)] {
+        for (gamma, delta) in [
+            (-0.09, 2e-4),
+            (-0.1, 1e-3),
+            (0.05, 1.6e-3),
+            (0.0, 1.8e-3),
+            (0.11, 3e-4),
+        ] {
             let st = law.evaluate(&w, gamma, delta);
             let bf = brute_force(KW, &w, gamma, delta, 200_000);
             if bf == 0.0 {
@@ -501,7 +517,12 @@ mod tests {
                 assert!(st.lost());
                 continue;
             }
-            assert!(((st.force - bf) / bf).abs() < 1e-6, "{gamma} {delta}: {} vs {}", st.force, bf);
+            assert!(
+                ((st.force - bf) / bf).abs() < 1e-6,
+                "{gamma} {delta}: {} vs {}",
+                st.force,
+                bf
+            );
             // Extreme contact points satisfy R(alpha) cos(alpha) = h (2.22).
             let h = R - delta;
             for a in [st.front_angle, st.rear_angle] {
@@ -515,7 +536,10 @@ mod tests {
         let delta = 2e-4;
         let aw = patch_angle(delta, R);
         let st = law.evaluate(&w, -0.095, delta);
-        assert!(st.front_angle < aw - 1e-6 && (st.rear_angle + aw).abs() < 1e-12, "{st:?}");
+        assert!(
+            st.front_angle < aw - 1e-6 && (st.rear_angle + aw).abs() < 1e-12,
+            "{st:?}"
+        );
     }
 
     #[test]

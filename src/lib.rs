@@ -12,7 +12,9 @@
 
 pub mod contact;
 pub mod error;
+pub mod params;
 pub mod profile;
+pub mod solver;
 pub mod track;
 pub mod vehicle;
 

@@ -246,7 +246,8 @@ mod tests {
 
     #[test]
     fn haversine_depth_at_centre_and_zero_at_edges() {
-        let w = WheelProfile::new(R, &[FlatSpec::haversine(0.1, 0.0015, 0.3)], "flat.left").unwrap();
+        let w =
+            WheelProfile::new(R, &[FlatSpec::haversine(0.1, 0.0015, 0.3)], "flat.left").unwrap();
         // Centre of the flat lies at space angle 0.3 - gamma.
         assert!((w.reduction(0.3, 0.0) - 0.0015).abs() < 1e-15);
         assert!((w.reduction(0.0, 0.3) - 0.0015).abs() < 1e-15);
@@ -292,7 +293,10 @@ mod tests {
             (FlatSpec::haversine(0.8, 0.001, 0.0), "flat.left[1].length"),
             (FlatSpec::haversine(0.1, 0.5, 0.0), "flat.left[1].depth"),
             (FlatSpec::haversine(-0.1, 0.001, 0.0), "flat.left[1].length"),
-            (FlatSpec::haversine(0.1, f64::NAN, 0.0), "flat.left[1].depth"),
+            (
+                FlatSpec::haversine(0.1, f64::NAN, 0.0),
+                "flat.left[1].depth",
+            ),
             (
                 FlatSpec {
                     length: 0.1,

@@ -449,8 +449,7 @@ impl Track {
             let (zl, zlp) = (self.z[k], self.z_prev[k]);
             let (zr, zrp) = (self.z[nk + k], self.z_prev[nk + k]);
             self.pad_left[i] = -c.kp * (zl - seat_l) - c.cp_dt * ((zl - zlp) - (seat_l - seat_lp));
-            self.pad_right[i] =
-                -c.kp * (zr - seat_r) - c.cp_dt * ((zr - zrp) - (seat_r - seat_rp));
+            self.pad_right[i] = -c.kp * (zr - seat_r) - c.cp_dt * ((zr - zrp) - (seat_r - seat_rp));
         }
         // 2. Rail stencil, written in place over the t_(j-1) arrays.
         let th_prev_ends = [
@@ -468,15 +467,17 @@ impl Track {
             let (zl, zc, zr) = (&z[..len - 2], &z[1..len - 1], &z[2..]);
             let (tl, tc, tr) = (&th[..len - 2], &th[1..len - 1], &th[2..]);
             let m = len - 2;
-            let (zl, zc, zr, tl, tc, tr) = (&zl[..m], &zc[..m], &zr[..m], &tl[..m], &tc[..m], &tr[..m]);
+            let (zl, zc, zr, tl, tc, tr) =
+                (&zl[..m], &zc[..m], &zr[..m], &tl[..m], &tc[..m], &tr[..m]);
             let (zn, tn) = (&mut zn[..m], &mut tn[..m]);
             for i in 0..m {
                 let zci = zc[i];
                 let tci = tc[i];
-                zn[i] = 2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
-                tn[i] = 2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i])
-                    + c.tz * (zr[i] - zl[i])
-                    - c.t0 * tci;
+                zn[i] =
+                    2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
+                tn[i] =
+                    2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i]) + c.tz * (zr[i] - zl[i])
+                        - c.t0 * tci;
             }
         }
         // 3. Pad and wheel forces on the new rail state; end conditions.
@@ -502,11 +503,17 @@ impl Track {
             }
             RailEnds::Pinned => {
                 // Ghost nodes: Z odd, theta even about the support.
-                let ends = [(0, 1), (nk - 1, nk - 2), (nk, nk + 1), (2 * nk - 1, 2 * nk - 2)];
+                let ends = [
+                    (0, 1),
+                    (nk - 1, nk - 2),
+                    (nk, nk + 1),
+                    (2 * nk - 1, 2 * nk - 2),
+                ];
                 for (e, (end, inner)) in ends.into_iter().enumerate() {
                     let sgn = if inner > end { 1.0 } else { -1.0 };
                     let (t0, ti, zi) = (self.th[end], self.th[inner], self.z[inner]);
-                    self.th_prev[end] = 2.0 * t0 - th_prev_ends[e] + c.tt * (2.0 * ti - 2.0 * t0)
+                    self.th_prev[end] = 2.0 * t0 - th_prev_ends[e]
+                        + c.tt * (2.0 * ti - 2.0 * t0)
                         + sgn * c.tz * 2.0 * zi
                         - c.t0 * t0;
                 }
@@ -515,8 +522,8 @@ impl Track {
         // 4. Sleepers (3.18), in place over the t_(j-1) arrays.
         for i in 0..self.zs.len() {
             let (fl, fr) = (self.pad_left[i], self.pad_right[i]);
-            self.zs_prev[i] = (c.zs_a * self.zs[i] + c.zs_b * self.zs_prev[i] - c.zs_f * (fl + fr))
-                * c.zs_den;
+            self.zs_prev[i] =
+                (c.zs_a * self.zs[i] + c.zs_b * self.zs_prev[i] - c.zs_f * (fl + fr)) * c.zs_den;
             self.ph_prev[i] =
                 (c.ph_a * self.ph[i] + c.ph_b * self.ph_prev[i] + c.ph_f * (fl - fr)) * c.ph_den;
         }
@@ -645,8 +652,12 @@ impl Track {
         self.ph_prev.copy_from_slice(&self.ph);
         for i in 0..ns {
             let kn = i * self.params.nodes_per_span;
-            self.pad_left[i] = -self.params.pad_stiffness * (self.z[kn] - self.zs[i] + 0.5 * self.params.rail_seat_distance * self.ph[i]);
-            self.pad_right[i] = -self.params.pad_stiffness * (self.z[nk + kn] - self.zs[i] - 0.5 * self.params.rail_seat_distance * self.ph[i]);
+            self.pad_left[i] = -self.params.pad_stiffness
+                * (self.z[kn] - self.zs[i] + 0.5 * self.params.rail_seat_distance * self.ph[i]);
+            self.pad_right[i] = -self.params.pad_stiffness
+                * (self.z[nk + kn]
+                    - self.zs[i]
+                    - 0.5 * self.params.rail_seat_distance * self.ph[i]);
         }
         Ok(())
     }
@@ -742,7 +753,14 @@ mod tests {
     #[test]
     fn critical_steps_reproduce_seed_table_4_2() {
         // Seed table 4.2 (table 4.1 track): n = 1..5, 10 -> 58, 46, 36, 29, 24, 13 us.
-        let seed = [(1, 58e-6), (2, 46e-6), (3, 36e-6), (4, 29e-6), (5, 24e-6), (10, 13e-6)];
+        let seed = [
+            (1, 58e-6),
+            (2, 46e-6),
+            (3, 36e-6),
+            (4, 29e-6),
+            (5, 24e-6),
+            (10, 13e-6),
+        ];
         for (n, dtc) in seed {
             let (ours, _) = seed_track(20, n).critical_time_step();
             // The seed found its values by trial to 1 us.
@@ -755,14 +773,20 @@ mod tests {
         let p = seed_track(10, 2);
         let (dtc, _) = p.critical_time_step();
         match Track::new(p, 1.01 * dtc) {
-            Err(Error::UnstableTimeStep { critical, limit, .. }) => {
+            Err(Error::UnstableTimeStep {
+                critical, limit, ..
+            }) => {
                 assert_eq!(critical, dtc);
                 assert!(limit.contains("rail"));
             }
             other => panic!("{other:?}"),
         }
         // Just below the limit the scheme stays bounded under a suddenly applied load...
-        let load = [PointLoad { rail: 0, position: 3.0, force: 1e5 }];
+        let load = [PointLoad {
+            rail: 0,
+            position: 3.0,
+            force: 1e5,
+        }];
         let mut t = Track::new(p, 0.98 * dtc).unwrap();
         for _ in 0..20_000 {
             t.step(&load);
@@ -774,7 +798,10 @@ mod tests {
         for _ in 0..20_000 {
             unstable.step(&load);
         }
-        let blown = unstable.rail_z(0).iter().any(|z| !z.is_finite() || z.abs() > 1.0);
+        let blown = unstable
+            .rail_z(0)
+            .iter()
+            .any(|z| !z.is_finite() || z.abs() > 1.0);
         assert!(blown);
     }
 
@@ -783,8 +810,16 @@ mod tests {
         let p = seed_track(8, 2);
         let x = 4.0 * 0.685 + 0.2;
         let loads = [
-            PointLoad { rail: 0, position: x, force: 1.0e5 },
-            PointLoad { rail: 1, position: x, force: 0.6e5 },
+            PointLoad {
+                rail: 0,
+                position: x,
+                force: 1.0e5,
+            },
+            PointLoad {
+                rail: 1,
+                position: x,
+                force: 0.6e5,
+            },
         ];
         let mut stat = Track::new(p, 40e-6).unwrap();
         stat.set_static(&loads).unwrap();
@@ -811,22 +846,44 @@ mod tests {
         let thmax = stat.th.iter().fold(0.0f64, |m, t| m.max(t.abs()));
         let dz = (0..2 * stat.nk).fold(0.0f64, |m, i| m.max((stat.z[i] - dynm.z[i]).abs()));
         let dth = (0..2 * stat.nk).fold(0.0f64, |m, i| m.max((stat.th[i] - dynm.th[i]).abs()));
-        assert!(dz < 1e-6 * zs.abs() && dth < 1e-6 * thmax, "{dz} {dth} {thmax}");
+        assert!(
+            dz < 1e-6 * zs.abs() && dth < 1e-6 * thmax,
+            "{dz} {dth} {thmax}"
+        );
         // Global equilibrium on a long track (ends far away): ballast carries the loads.
         let long = seed_track(40, 2);
         let mid = 20.0 * 0.685 + 0.2;
         let mut lt = Track::new(long, 40e-6).unwrap();
         lt.set_static(&[
-            PointLoad { rail: 0, position: mid, force: 1.0e5 },
-            PointLoad { rail: 1, position: mid, force: 0.6e5 },
+            PointLoad {
+                rail: 0,
+                position: mid,
+                force: 1.0e5,
+            },
+            PointLoad {
+                rail: 1,
+                position: mid,
+                force: 0.6e5,
+            },
         ])
         .unwrap();
-        let ballast: f64 = lt.zs.iter().map(|z| -2.0 * long.ballast_stiffness * z).sum();
+        let ballast: f64 = lt
+            .zs
+            .iter()
+            .map(|z| -2.0 * long.ballast_stiffness * z)
+            .sum();
         assert!((ballast - 1.6e5).abs() < 1e-5 * 1.6e5, "{ballast}");
         // Roll: moment of the ballast reactions balances the unequal rail loads.
         let ls = 0.5 * long.rail_seat_distance;
-        let moment: f64 = lt.ph.iter().map(|f| 2.0 * ls * ls * long.ballast_stiffness * f).sum();
-        assert!((moment - ls * (1.0e5 - 0.6e5)).abs() < 1e-5 * ls * 1e5, "{moment}");
+        let moment: f64 = lt
+            .ph
+            .iter()
+            .map(|f| 2.0 * ls * ls * long.ballast_stiffness * f)
+            .sum();
+        assert!(
+            (moment - ls * (1.0e5 - 0.6e5)).abs() < 1e-5 * ls * 1e5,
+            "{moment}"
+        );
         // A static state is a fixed point of the stepper.
         let before = stat.z.clone();
         for _ in 0..100 {
@@ -861,12 +918,19 @@ mod tests {
         }
         let f_bounce = 1.0 / mean_period(&bz, dt);
         let f_roll = 1.0 / mean_period(&bp, dt);
-        let est_b = (2.0 * p.ballast_stiffness / p.sleeper_mass).sqrt() / (2.0 * std::f64::consts::PI);
+        let est_b =
+            (2.0 * p.ballast_stiffness / p.sleeper_mass).sqrt() / (2.0 * std::f64::consts::PI);
         let ls = 0.5 * p.rail_seat_distance;
         let est_r = (2.0 * ls * ls * p.ballast_stiffness / p.sleeper_inertia).sqrt()
             / (2.0 * std::f64::consts::PI);
-        assert!(((f_bounce - est_b) / est_b).abs() < 1e-3, "{f_bounce} vs {est_b}");
-        assert!(((f_roll - est_r) / est_r).abs() < 1e-3, "{f_roll} vs {est_r}");
+        assert!(
+            ((f_bounce - est_b) / est_b).abs() < 1e-3,
+            "{f_bounce} vs {est_b}"
+        );
+        assert!(
+            ((f_roll - est_r) / est_r).abs() < 1e-3,
+            "{f_roll} vs {est_r}"
+        );
     }
 
     /// Closed-form frequency (Hz) of mode j of a simply supported Timoshenko beam.
@@ -935,7 +999,12 @@ mod tests {
         let (dtc, _) = p.critical_time_step();
         let mut t = Track::new(p, 0.9 * dtc).unwrap();
         // Start from a static deflection then release the load.
-        t.set_static(&[PointLoad { rail: 0, position: 2.0, force: 1e5 }]).unwrap();
+        t.set_static(&[PointLoad {
+            rail: 0,
+            position: 2.0,
+            force: 1e5,
+        }])
+        .unwrap();
         let k = t.stiffness_matrix();
         let e0 = t.discrete_energy(&k);
         let mut worst: f64 = 0.0;

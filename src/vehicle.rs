@@ -57,7 +57,11 @@ impl RollPlaneParams {
         positive("vehicle.primary.stiffness", self.primary_stiffness, "N/m")?;
         non_negative("vehicle.primary.damping", self.primary_damping, "N s/m")?;
         positive("vehicle.primary.spacing", self.primary_spacing, "m")?;
-        positive("vehicle.secondary.stiffness", self.secondary_stiffness, "N/m")?;
+        positive(
+            "vehicle.secondary.stiffness",
+            self.secondary_stiffness,
+            "N/m",
+        )?;
         non_negative("vehicle.secondary.damping", self.secondary_damping, "N s/m")?;
         positive("vehicle.secondary.spacing", self.secondary_spacing, "m")?;
         non_negative("gravity", self.gravity, "m/s^2")?;
@@ -160,7 +164,9 @@ impl RollPlaneVehicle {
         let id = Matrix6::<f64>::identity();
         // [I + dt/2 M^-1 C] d+ = dt^2 M^-1 F + [2I - dt^2 M^-1 K] d + [dt/2 M^-1 C - I] d-
         let lhs = id + mc * (0.5 * dt);
-        let inv = lhs.try_inverse().expect("I + dt/2 M^-1 C is diagonally dominant");
+        let inv = lhs
+            .try_inverse()
+            .expect("I + dt/2 M^-1 C is diagonally dominant");
         Ok(RollPlaneVehicle {
             params,
             dt,
@@ -244,7 +250,10 @@ impl RollPlaneVehicle {
         let kab = k.fixed_view::<4, 2>(0, 4);
         let g = self.gravity;
         let rhs = Vector4::new(g[0], g[1], g[2], g[3]) - kab * nalgebra::Vector2::new(zw, phw);
-        let da = kaa.lu().solve(&rhs).expect("suspension stiffness matrix is regular");
+        let da = kaa
+            .lu()
+            .solve(&rhs)
+            .expect("suspension stiffness matrix is regular");
         self.d = Vector6::new(da[0], da[1], da[2], da[3], zw, phw);
         self.d_prev = self.d;
     }
@@ -385,7 +394,8 @@ impl LumpedTrack {
         for i in 0..2 {
             let a = q.mass / (dt * dt);
             let b = q.damping / (2.0 * dt);
-            let rhs = -p[i] - q.stiffness * self.z[i] + a * (2.0 * self.z[i] - self.z_prev[i])
+            let rhs = -p[i] - q.stiffness * self.z[i]
+                + a * (2.0 * self.z[i] - self.z_prev[i])
                 + b * self.z_prev[i];
             let next = rhs / (a + b);
             self.z_prev[i] = self.z[i];
@@ -440,7 +450,10 @@ mod tests {
         assert!((v.displacements() - before).norm() < 1e-12);
         let b = v.bearing_forces();
         let upper = w - 0.5 * p.wheelset_mass * p.gravity;
-        assert!((b[0] - upper).abs() < 1e-6 && (b[1] - upper).abs() < 1e-6, "{b:?}");
+        assert!(
+            (b[0] - upper).abs() < 1e-6 && (b[1] - upper).abs() < 1e-6,
+            "{b:?}"
+        );
     }
 
     /// Spectrum magnitude of `sig` at frequency f (Hz), Hann-windowed.
@@ -517,7 +530,10 @@ mod tests {
         let mut p = table_4_4();
         p.wheelset_mass = -1.0;
         let e = RollPlaneVehicle::new(p, 1e-5).unwrap_err().to_string();
-        assert!(e.contains("vehicle.wheelset.mass") && e.contains("-1"), "{e}");
+        assert!(
+            e.contains("vehicle.wheelset.mass") && e.contains("-1"),
+            "{e}"
+        );
         let mut p = table_4_4();
         p.primary_damping = f64::NAN;
         let e = RollPlaneVehicle::new(p, 1e-5).unwrap_err().to_string();

@@ -1,0 +1,353 @@
+//! The coupled vehicle-track-contact solver.
+//!
+//! One step, in the order of `MODEL.md`: at `t_j` the wheel displacements and the axle
+//! angle give the rail displacement under each wheel, then the contact forces `P_j`;
+//! vehicle and track are then advanced to `t_(j+1)` with `P_j`. The run starts from
+//! the static equilibrium of the whole system, solved directly.
+
+use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
+use crate::error::{Error, Result, finite, non_negative, out_of_range, positive};
+use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
+use crate::profile::WheelProfile;
+use crate::track::{PointLoad, Track};
+use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
+
+/// Track state of a simulation.
+#[derive(Debug, Clone)]
+pub enum TrackState {
+    /// Discrete Timoshenko track.
+    Discrete(Track),
+    /// Chapter-2 lumped track.
+    Lumped(LumpedTrack),
+}
+
+/// Vehicle state of a simulation.
+#[derive(Debug, Clone)]
+pub enum VehicleState {
+    /// Six-DOF roll-plane vehicle.
+    RollPlane(RollPlaneVehicle),
+    /// Chapter-2 lumped wheels.
+    LumpedWheels(LumpedWheels),
+    /// Constant loads (N), no contact.
+    ConstantLoad([f64; 2]),
+}
+
+/// Everything reported at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Sample {
+    /// Time `t_j` (s).
+    pub time: f64,
+    /// Wheel position along the track (m).
+    pub position: f64,
+    /// Axle rotation angle `gamma` (rad).
+    pub rotation: f64,
+    /// Wheel-centre displacements `[left, right]` (m).
+    pub wheel_z: [f64; 2],
+    /// Rail displacements under the wheels (m).
+    pub rail_z: [f64; 2],
+    /// Contact states (force, overlap, patch angles, length).
+    pub contact: [ContactState; 2],
+}
+
+/// A running coupled simulation.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    scenario: Scenario,
+    track: TrackState,
+    vehicle: VehicleState,
+    wheels: [WheelProfile; 2],
+    law: ContactLaw,
+    dt: f64,
+    steps: u64,
+    static_load: [f64; 2],
+    max_force: [f64; 2],
+    min_force: [f64; 2],
+}
+
+/// Time step used when the scenario asks for the default (`dt = 0`) (s).
+pub fn default_dt(scenario: &Scenario) -> f64 {
+    match &scenario.track {
+        TrackSpec::Discrete(t) => DEFAULT_DT_FRACTION * t.critical_time_step().0,
+        TrackSpec::Lumped(_) => 1e-6,
+    }
+}
+
+impl Simulation {
+    /// Builds the models, checks every parameter and puts the system in static
+    /// equilibrium at the start position.
+    pub fn new(scenario: &Scenario) -> Result<Self> {
+        let s = scenario;
+        positive("wheel.radius", s.wheel_radius, "m")?;
+        finite("speed", s.speed, "m/s")?;
+        if s.speed < 0.0 {
+            return Err(out_of_range("speed", s.speed, ">= 0 m/s"));
+        }
+        finite("start_position", s.start_position, "m")?;
+        non_negative("solver.dt", s.dt, "s")?;
+        non_negative("contact.Kw", s.kw, "N/m/rad")?;
+        non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
+        let dt = if s.dt == 0.0 { default_dt(s) } else { s.dt };
+        let wheels = [
+            WheelProfile::new(s.wheel_radius, &s.flats[0], "flat.left")?,
+            WheelProfile::new(s.wheel_radius, &s.flats[1], "flat.right")?,
+        ];
+        let track = match &s.track {
+            TrackSpec::Discrete(p) => {
+                p.validate()?;
+                let len = p.length();
+                if !(s.start_position > 0.0 && s.start_position < len) {
+                    return Err(out_of_range(
+                        "start_position",
+                        s.start_position,
+                        format!("inside the track, 0 < x < {len} m"),
+                    ));
+                }
+                TrackState::Discrete(Track::new(*p, dt)?)
+            }
+            TrackSpec::Lumped(p) => TrackState::Lumped(LumpedTrack::new(*p, dt)?),
+        };
+        let (vehicle, static_load) = match &s.vehicle {
+            VehicleSpec::RollPlane(p) => {
+                let v = RollPlaneVehicle::new(*p, dt)?;
+                let w = p.static_wheel_load();
+                (VehicleState::RollPlane(v), [w, w])
+            }
+            VehicleSpec::LumpedWheels(p) => (
+                VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?),
+                [p.load; 2],
+            ),
+            VehicleSpec::ConstantLoad(p) => {
+                non_negative("load.left", p[0], "N")?;
+                non_negative("load.right", p[1], "N")?;
+                (VehicleState::ConstantLoad(*p), *p)
+            }
+        };
+        let law = match s.contact_model {
+            ContactModel::Adaptive => {
+                let kw = if s.kw > 0.0 {
+                    s.kw
+                } else {
+                    kw_from_hertz(s.hertz_coefficient, static_load[0].max(1.0), s.wheel_radius)?
+                };
+                ContactLaw::adaptive(kw)?
+            }
+            ContactModel::Hertz => ContactLaw::hertz(s.hertz_coefficient)?,
+        };
+        let mut sim = Simulation {
+            scenario: s.clone(),
+            track,
+            vehicle,
+            wheels,
+            law,
+            dt,
+            steps: 0,
+            static_load,
+            max_force: [f64::NEG_INFINITY; 2],
+            min_force: [f64::INFINITY; 2],
+        };
+        sim.set_static()?;
+        Ok(sim)
+    }
+
+    /// Static equilibrium of the whole system at the start position: static wheel
+    /// loads from the vehicle, track deflection under them (direct solve), overlaps
+    /// from the inverse contact law, then the vehicle resting on those wheel heights.
+    fn set_static(&mut self) -> Result<()> {
+        let x = self.scenario.start_position;
+        let p = self.static_load;
+        let zr = match &mut self.track {
+            TrackState::Discrete(t) => {
+                t.set_static(&[
+                    PointLoad {
+                        rail: 0,
+                        position: x,
+                        force: p[0],
+                    },
+                    PointLoad {
+                        rail: 1,
+                        position: x,
+                        force: p[1],
+                    },
+                ])?;
+                [t.rail_z_at(0, x), t.rail_z_at(1, x)]
+            }
+            TrackState::Lumped(t) => {
+                t.set_static(p);
+                t.rail_z()
+            }
+        };
+        let delta = [
+            self.law.overlap_for_force(&self.wheels[0], 0.0, p[0]),
+            self.law.overlap_for_force(&self.wheels[1], 0.0, p[1]),
+        ];
+        let zw = [zr[0] - delta[0], zr[1] - delta[1]];
+        match &mut self.vehicle {
+            VehicleState::RollPlane(v) => v.set_static(zw),
+            VehicleState::LumpedWheels(v) => v.set_static(zw),
+            VehicleState::ConstantLoad(_) => {}
+        }
+        Ok(())
+    }
+
+    /// Time step (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// Current time `t_j` (s).
+    pub fn time(&self) -> f64 {
+        self.steps as f64 * self.dt
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    /// Wheel position at the current time (m).
+    pub fn position(&self) -> f64 {
+        self.scenario.start_position + self.scenario.speed * self.time()
+    }
+    /// Axle rotation angle at the current time (rad) (2.17).
+    pub fn rotation(&self) -> f64 {
+        self.scenario.speed * self.time() / self.scenario.wheel_radius
+    }
+    /// Static wheel loads (N).
+    pub fn static_load(&self) -> [f64; 2] {
+        self.static_load
+    }
+    /// The contact law in use (with the calibrated `K_w`).
+    pub fn contact_law(&self) -> &ContactLaw {
+        &self.law
+    }
+    /// Largest contact force per wheel since the start (N).
+    pub fn max_force(&self) -> [f64; 2] {
+        self.max_force
+    }
+    /// Smallest contact force per wheel since the start (N).
+    pub fn min_force(&self) -> [f64; 2] {
+        self.min_force
+    }
+    /// Track state.
+    pub fn track(&self) -> &TrackState {
+        &self.track
+    }
+    /// Vehicle state.
+    pub fn vehicle(&self) -> &VehicleState {
+        &self.vehicle
+    }
+    /// The scenario.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Wheel-centre displacements (m).
+    pub fn wheel_z(&self) -> [f64; 2] {
+        match &self.vehicle {
+            VehicleState::RollPlane(v) => v.wheel_z(),
+            VehicleState::LumpedWheels(v) => v.wheel_z(),
+            VehicleState::ConstantLoad(_) => self.rail_z(),
+        }
+    }
+
+    /// Rail displacements under the wheels (m) (3.23).
+    pub fn rail_z(&self) -> [f64; 2] {
+        let x = self.position();
+        match &self.track {
+            TrackState::Discrete(t) => [t.rail_z_at(0, x), t.rail_z_at(1, x)],
+            TrackState::Lumped(t) => t.rail_z(),
+        }
+    }
+
+    /// Everything at the current time, contact forces included.
+    pub fn sample(&self) -> Sample {
+        let wheel_z = self.wheel_z();
+        let rail_z = self.rail_z();
+        let rotation = self.rotation();
+        let contact = match &self.vehicle {
+            VehicleState::ConstantLoad(p) => [
+                ContactState {
+                    force: p[0],
+                    intervals: 1,
+                    ..Default::default()
+                },
+                ContactState {
+                    force: p[1],
+                    intervals: 1,
+                    ..Default::default()
+                },
+            ],
+            _ => [
+                self.law
+                    .evaluate(&self.wheels[0], rotation, rail_z[0] - wheel_z[0]),
+                self.law
+                    .evaluate(&self.wheels[1], rotation, rail_z[1] - wheel_z[1]),
+            ],
+        };
+        Sample {
+            time: self.time(),
+            position: self.position(),
+            rotation,
+            wheel_z,
+            rail_z,
+            contact,
+        }
+    }
+
+    /// Advances one step and returns the sample at `t_j` whose contact forces drove it.
+    pub fn step(&mut self) -> Result<Sample> {
+        let x = self.position();
+        if let TrackState::Discrete(t) = &self.track {
+            let len = t.params().length();
+            if !(x > 0.0 && x < len) {
+                return Err(Error::OffTrack {
+                    position: x,
+                    length: len,
+                    time: self.time(),
+                });
+            }
+        }
+        let s = self.sample();
+        let p = [s.contact[0].force, s.contact[1].force];
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return Err(Error::NonFinite {
+                what: "contact force".into(),
+                time: s.time,
+            });
+        }
+        for i in 0..2 {
+            self.max_force[i] = self.max_force[i].max(p[i]);
+            self.min_force[i] = self.min_force[i].min(p[i]);
+        }
+        match &mut self.vehicle {
+            VehicleState::RollPlane(v) => v.step(p),
+            VehicleState::LumpedWheels(v) => v.step(p),
+            VehicleState::ConstantLoad(_) => {}
+        }
+        match &mut self.track {
+            TrackState::Discrete(t) => t.step(&[
+                PointLoad {
+                    rail: 0,
+                    position: x,
+                    force: p[0],
+                },
+                PointLoad {
+                    rail: 1,
+                    position: x,
+                    force: p[1],
+                },
+            ]),
+            TrackState::Lumped(t) => t.step(p),
+        }
+        self.steps += 1;
+        Ok(s)
+    }
+
+    /// Runs until `duration` (s) from now, calling `each` with every sample.
+    pub fn run(&mut self, duration: f64, mut each: impl FnMut(&Sample)) -> Result<()> {
+        non_negative("duration", duration, "s")?;
+        let n = (duration / self.dt).round() as u64;
+        for _ in 0..n {
+            let s = self.step()?;
+            each(&s);
+        }
+        Ok(())
+    }
+}
