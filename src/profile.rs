@@ -10,7 +10,14 @@ use crate::error::{Result, finite, out_of_range, positive};
 use std::f64::consts::PI;
 
 /// Wraps an angle (rad) into (-pi, pi].
+#[inline]
 pub fn wrap_angle(a: f64) -> f64 {
+    if a > -PI && a <= PI {
+        return a;
+    }
+    if !a.is_finite() {
+        return a;
+    }
     let mut r = a.rem_euclid(2.0 * PI);
     if r > PI {
         r -= 2.0 * PI;

@@ -209,6 +209,11 @@ impl Simulation {
     pub fn rotation(&self) -> f64 {
         self.scenario.speed * self.time() / self.scenario.wheel_radius
     }
+
+    /// Axle rotation angle wrapped into [0, 2 pi) (rad): what places the flats.
+    fn rotation_wrapped(&self) -> f64 {
+        self.rotation().rem_euclid(std::f64::consts::TAU)
+    }
     /// Static wheel loads (N).
     pub fn static_load(&self) -> [f64; 2] {
         self.static_load
@@ -261,6 +266,7 @@ impl Simulation {
         let wheel_z = self.wheel_z();
         let rail_z = self.rail_z();
         let rotation = self.rotation();
+        let gamma = self.rotation_wrapped();
         let contact = match &self.vehicle {
             VehicleState::ConstantLoad(p) => [
                 ContactState {

@@ -287,6 +287,115 @@ pub struct Track {
     ph_prev: Vec<f64>,
     pad_left: Vec<f64>,
     pad_right: Vec<f64>,
+    /// Scratch: rail deflections at the sleeper nodes (left, right, left at t_(j-1), right at t_(j-1)).
+    gather: Vec<f64>,
+    simd: bool,
+}
+
+/// Borrowed views for the sleeper update.
+struct SleeperSlices<'a> {
+    rl: &'a [f64],
+    rr: &'a [f64],
+    rlp: &'a [f64],
+    rrp: &'a [f64],
+    zs: &'a [f64],
+    ph: &'a [f64],
+    zsp: &'a mut [f64],
+    php: &'a mut [f64],
+    pl: &'a mut [f64],
+    pr: &'a mut [f64],
+}
+
+/// Pad forces (3.9) and sleeper update (3.18) for every sleeper.
+#[inline(always)]
+fn sleepers_body(s: SleeperSlices<'_>, c: &Coeffs, ls: f64) {
+    let ns = s.zs.len();
+    let (rl, rr, rlp, rrp) = (&s.rl[..ns], &s.rr[..ns], &s.rlp[..ns], &s.rrp[..ns]);
+    let (zs, ph) = (&s.zs[..ns], &s.ph[..ns]);
+    let (zsp, php) = (&mut s.zsp[..ns], &mut s.php[..ns]);
+    let (pl, pr) = (&mut s.pl[..ns], &mut s.pr[..ns]);
+    for i in 0..ns {
+        let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
+        let seat_l = z - ls * f;
+        let seat_r = z + ls * f;
+        let dseat_l = seat_l - (zp - ls * fp);
+        let dseat_r = seat_r - (zp + ls * fp);
+        let (a, b) = (rl[i], rr[i]);
+        let fl = -c.kp * (a - seat_l) - c.cp_dt * ((a - rlp[i]) - dseat_l);
+        let fr = -c.kp * (b - seat_r) - c.cp_dt * ((b - rrp[i]) - dseat_r);
+        pl[i] = fl;
+        pr[i] = fr;
+        zsp[i] = (c.zs_a * z + c.zs_b * zp - c.zs_f * (fl + fr)) * c.zs_den;
+        php[i] = (c.ph_a * f + c.ph_b * fp + c.ph_f * (fl - fr)) * c.ph_den;
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn sleepers_avx2(s: SleeperSlices<'_>, c: &Coeffs, ls: f64) {
+    sleepers_body(s, c, ls)
+}
+
+#[inline]
+fn sleepers(s: SleeperSlices<'_>, c: &Coeffs, ls: f64, simd: bool) {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: `simd` is only true when the CPU reports AVX2.
+        unsafe { sleepers_avx2(s, c, ls) };
+        return;
+    }
+    let _ = simd;
+    sleepers_body(s, c, ls)
+}
+
+/// Rail stencil over both rails stored end to end: new values are written over the
+/// t_(j-1) arrays. The end nodes are left to the caller.
+#[inline(always)]
+fn stencil_body(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs) {
+    let len = z.len();
+    let m = len - 2;
+    let (zl, zc, zr) = (&z[..m], &z[1..m + 1], &z[2..m + 2]);
+    let (tl, tc, tr) = (&th[..m], &th[1..m + 1], &th[2..m + 2]);
+    let zn = &mut z_prev[1..m + 1];
+    let tn = &mut th_prev[1..m + 1];
+    for i in 0..m {
+        let zci = zc[i];
+        let tci = tc[i];
+        zn[i] = 2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
+        tn[i] = 2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i]) + c.tz * (zr[i] - zl[i])
+            - c.t0 * tci;
+    }
+}
+
+/// The same stencil compiled for AVX2 (4 lanes). No FMA is used, so both versions
+/// give bit-identical results.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn stencil_avx2(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs) {
+    stencil_body(z, th, z_prev, th_prev, c)
+}
+
+#[inline]
+fn stencil(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs, simd: bool) {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: `simd` is only true when the CPU reports AVX2 (checked in `new_unchecked`).
+        unsafe { stencil_avx2(z, th, z_prev, th_prev, c) };
+        return;
+    }
+    let _ = simd;
+    stencil_body(z, th, z_prev, th_prev, c)
+}
+
+fn cpu_has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 impl Track {
@@ -353,6 +462,8 @@ impl Track {
             ph_prev: vec![0.0; ns],
             pad_left: vec![0.0; ns],
             pad_right: vec![0.0; ns],
+            gather: vec![0.0; 4 * ns],
+            simd: cpu_has_avx2(),
         }
     }
 
@@ -421,7 +532,8 @@ impl Track {
     pub fn locate(&self, x: f64) -> (usize, f64) {
         let dx = self.params.dx();
         let s = (x / dx).max(0.0);
-        let k = (s.floor() as usize).min(self.nk - 2);
+        // Truncation equals floor for s >= 0 and avoids a libm call.
+        let k = (s as usize).min(self.nk - 2);
         (k, (s - k as f64).clamp(0.0, 1.0))
     }
 
@@ -439,17 +551,43 @@ impl Track {
         let nk = self.nk;
         let n = self.params.nodes_per_span;
         let ls = 0.5 * self.params.rail_seat_distance;
-        // 1. Pad forces at t_j (backward-difference damper velocities).
-        for i in 0..self.zs.len() {
-            let k = i * n;
-            let seat_l = self.zs[i] - ls * self.ph[i];
-            let seat_r = self.zs[i] + ls * self.ph[i];
-            let seat_lp = self.zs_prev[i] - ls * self.ph_prev[i];
-            let seat_rp = self.zs_prev[i] + ls * self.ph_prev[i];
-            let (zl, zlp) = (self.z[k], self.z_prev[k]);
-            let (zr, zrp) = (self.z[nk + k], self.z_prev[nk + k]);
-            self.pad_left[i] = -c.kp * (zl - seat_l) - c.cp_dt * ((zl - zlp) - (seat_l - seat_lp));
-            self.pad_right[i] = -c.kp * (zr - seat_r) - c.cp_dt * ((zr - zrp) - (seat_r - seat_rp));
+        // 1. Pad forces at t_j (backward-difference damper velocities) and the sleeper
+        //    update (3.18), in place over the t_(j-1) sleeper arrays. Rail values at the
+        //    sleeper nodes are gathered first so that the sleeper loop vectorises.
+        {
+            let ns = self.zs.len();
+            let g = &mut self.gather;
+            let (rl, rest) = g.split_at_mut(ns);
+            let (rr, rest) = rest.split_at_mut(ns);
+            let (rlp, rrp) = rest.split_at_mut(ns);
+            let (zl, zr) = self.z.split_at(nk);
+            let (zlp, zrp) = self.z_prev.split_at(nk);
+            for (i, (((a, b), cc), d)) in rl
+                .iter_mut()
+                .zip(rr.iter_mut())
+                .zip(rlp.iter_mut())
+                .zip(rrp.iter_mut())
+                .enumerate()
+            {
+                let k = i * n;
+                *a = zl[k];
+                *b = zr[k];
+                *cc = zlp[k];
+                *d = zrp[k];
+            }
+            let sl = SleeperSlices {
+                rl,
+                rr,
+                rlp,
+                rrp,
+                zs: &self.zs,
+                ph: &self.ph,
+                zsp: &mut self.zs_prev,
+                php: &mut self.ph_prev,
+                pl: &mut self.pad_left,
+                pr: &mut self.pad_right,
+            };
+            sleepers(sl, &c, ls, self.simd);
         }
         // 2. Rail stencil, written in place over the t_(j-1) arrays.
         let th_prev_ends = [
@@ -458,33 +596,24 @@ impl Track {
             self.th_prev[nk],
             self.th_prev[2 * nk - 1],
         ];
-        {
-            let len = 2 * nk;
-            let z = &self.z[..len];
-            let th = &self.th[..len];
-            let zn = &mut self.z_prev[1..len - 1];
-            let tn = &mut self.th_prev[1..len - 1];
-            let (zl, zc, zr) = (&z[..len - 2], &z[1..len - 1], &z[2..]);
-            let (tl, tc, tr) = (&th[..len - 2], &th[1..len - 1], &th[2..]);
-            let m = len - 2;
-            let (zl, zc, zr, tl, tc, tr) =
-                (&zl[..m], &zc[..m], &zr[..m], &tl[..m], &tc[..m], &tr[..m]);
-            let (zn, tn) = (&mut zn[..m], &mut tn[..m]);
-            for i in 0..m {
-                let zci = zc[i];
-                let tci = tc[i];
-                zn[i] =
-                    2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
-                tn[i] =
-                    2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i]) + c.tz * (zr[i] - zl[i])
-                        - c.t0 * tci;
-            }
-        }
+        stencil(
+            &self.z,
+            &self.th,
+            &mut self.z_prev,
+            &mut self.th_prev,
+            &c,
+            self.simd,
+        );
         // 3. Pad and wheel forces on the new rail state; end conditions.
-        for i in 0..self.zs.len() {
-            let k = i * n;
-            self.z_prev[k] += c.force * self.pad_left[i];
-            self.z_prev[nk + k] += c.force * self.pad_right[i];
+        {
+            let ns = self.zs.len();
+            let (pl, pr) = (&self.pad_left[..ns], &self.pad_right[..ns]);
+            let (zl, zr) = self.z_prev.split_at_mut(nk);
+            for i in 0..ns {
+                let k = i * n;
+                zl[k] += c.force * pl[i];
+                zr[k] += c.force * pr[i];
+            }
         }
         for l in loads {
             let (k, w) = self.locate(l.position);
@@ -518,14 +647,6 @@ impl Track {
                         - c.t0 * t0;
                 }
             }
-        }
-        // 4. Sleepers (3.18), in place over the t_(j-1) arrays.
-        for i in 0..self.zs.len() {
-            let (fl, fr) = (self.pad_left[i], self.pad_right[i]);
-            self.zs_prev[i] =
-                (c.zs_a * self.zs[i] + c.zs_b * self.zs_prev[i] - c.zs_f * (fl + fr)) * c.zs_den;
-            self.ph_prev[i] =
-                (c.ph_a * self.ph[i] + c.ph_b * self.ph_prev[i] + c.ph_f * (fl - fr)) * c.ph_den;
         }
         std::mem::swap(&mut self.z, &mut self.z_prev);
         std::mem::swap(&mut self.th, &mut self.th_prev);
