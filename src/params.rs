@@ -64,9 +64,9 @@ pub struct Scenario {
 
 /// Grid nodes per sleeper span used by default: the converged choice of the grid
 /// study in `docs/VALIDATION.md` (the seed used 2).
-pub const DEFAULT_NODES_PER_SPAN: usize = 4;
+pub const DEFAULT_NODES_PER_SPAN: usize = 8;
 /// Default time step as a fraction of the critical step.
-pub const DEFAULT_DT_FRACTION: f64 = 0.5;
+pub const DEFAULT_DT_FRACTION: f64 = 0.9;
 
 /// km/h to m/s.
 pub fn kmh(v: f64) -> f64 {

@@ -1,0 +1,231 @@
+//! Coupled-engine tests against the seed's published numbers, the static equilibrium,
+//! the grid-convergence claim and the bad-input rules.
+
+use wheelflat::Error;
+use wheelflat::contact::ContactModel;
+use wheelflat::params::{Scenario, TrackSpec};
+use wheelflat::profile::FlatSpec;
+use wheelflat::solver::Simulation;
+
+fn seed_grid(mut s: Scenario) -> Scenario {
+    s.set_nodes_per_span(2);
+    s.dt = 45e-6;
+    s
+}
+
+/// Frequency (Hz) of the oscillation of `f` about `mean` in `[t0, t1]` from its
+/// downward mean crossings.
+fn crossing_frequency(t: &[f64], f: &[f64], mean: f64, t0: f64, t1: f64) -> f64 {
+    let mut cr = Vec::new();
+    for k in 0..t.len() - 1 {
+        if t[k] < t0 || t[k] > t1 {
+            continue;
+        }
+        let (a, b) = (f[k] - mean, f[k + 1] - mean);
+        if a > 0.0 && b <= 0.0 {
+            cr.push(t[k] + a / (a - b) * (t[k + 1] - t[k]));
+        }
+    }
+    assert!(cr.len() >= 3, "{cr:?}");
+    (cr.len() - 1) as f64 / (cr[cr.len() - 1] - cr[0])
+}
+
+#[test]
+fn starts_in_static_equilibrium_and_stays_there_at_rest() {
+    let mut s = Scenario::table_4_4();
+    s.speed = 0.0;
+    s.start_position = 10.0;
+    let mut sim = Simulation::new(&s).unwrap();
+    let w = sim.static_load()[0];
+    // Seed: static wheel load 107.6 kN with table 4.4 and gravity on every body.
+    assert!((w - 107.6e3).abs() < 0.1e3, "{w}");
+    for _ in 0..2000 {
+        let x = sim.step().unwrap();
+        for c in x.contact {
+            assert!(((c.force - w) / w).abs() < 1e-9, "{} vs {w}", c.force);
+        }
+    }
+}
+
+#[test]
+fn perfect_wheel_at_100_kmh_matches_seed_force_band() {
+    // Seed section 4.3.1 (table 4.4, 20 spans, n = 2, dt = 45 us): steady-state contact
+    // force between about 105.8 and 113 kN.
+    let mut s = seed_grid(Scenario::table_4_4());
+    s.set_spans(20);
+    s.speed = 100.0 / 3.6;
+    s.start_position = 0.685;
+    let mut sim = Simulation::new(&s).unwrap();
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    sim.run(0.4, |x| {
+        if x.time > 0.1 && x.time < 0.35 {
+            lo = lo.min(x.contact[0].force);
+            hi = hi.max(x.contact[0].force);
+        }
+    })
+    .unwrap();
+    assert!((lo - 105.8e3).abs() < 3.5e3, "min {lo}");
+    assert!((hi - 113.0e3).abs() < 2.0e3, "max {hi}");
+}
+
+#[test]
+fn reference_flat_at_seed_grid_is_near_seed_result() {
+    // Seed: 404.7 kN at the flat wheel, over 3.5 x static; about 1.5 x static at the other.
+    let mut sim = Simulation::new(&seed_grid(Scenario::table_4_4_flat())).unwrap();
+    sim.run(0.8, |_| {}).unwrap();
+    let p = sim.max_force();
+    let w = sim.static_load()[0];
+    assert!(((p[0] - 404.7e3) / 404.7e3).abs() < 0.08, "{p:?}");
+    assert!(p[0] / w > 3.5);
+    assert!((p[1] / w - 1.5).abs() < 0.12, "{}", p[1] / w);
+    // Total loss of contact before the impact (seed fig. 5.3).
+    assert_eq!(sim.min_force()[0], 0.0);
+}
+
+#[test]
+fn default_grid_is_within_two_percent_of_refined_grid() {
+    let first_peak = |n: Option<usize>| {
+        let mut s = Scenario::table_4_4_flat();
+        if let Some(n) = n {
+            s.set_nodes_per_span(n);
+        }
+        let mut sim = Simulation::new(&s).unwrap();
+        sim.run(0.1, |_| {}).unwrap();
+        sim.max_force()[0]
+    };
+    let default = first_peak(None);
+    let fine = first_peak(Some(16));
+    assert!(
+        ((default - fine) / fine).abs() < 0.02,
+        "{default} vs {fine}"
+    );
+    // And the seed's n = 2 is not converged: more than 20 % above.
+    let mut s = seed_grid(Scenario::table_4_4_flat());
+    s.dt = 0.0;
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run(0.1, |_| {}).unwrap();
+    assert!(sim.max_force()[0] > 1.2 * fine);
+}
+
+#[test]
+fn chapter_2_lumped_model_hertz_peak_and_ringing() {
+    // Seed: Hertz 145.4 kN, post-impact oscillation 714 Hz (Hertz).
+    let run = |model| {
+        let mut s = Scenario::chapter_2();
+        s.contact_model = model;
+        let mut sim = Simulation::new(&s).unwrap();
+        let (mut t, mut f) = (Vec::new(), Vec::new());
+        sim.run(0.1, |x| {
+            t.push(x.time);
+            f.push(x.contact[0].force);
+        })
+        .unwrap();
+        let (ip, _) = f
+            .iter()
+            .enumerate()
+            .fold((0, 0.0), |m, (i, v)| if *v > m.1 { (i, *v) } else { m });
+        let freq = crossing_frequency(&t, &f, 82e3, t[ip], t[ip] + 0.006);
+        (sim.max_force()[0], freq)
+    };
+    let (hz_peak, hz_freq) = run(ContactModel::Hertz);
+    let (ad_peak, ad_freq) = run(ContactModel::Adaptive);
+    assert!(((hz_peak - 145.4e3) / 145.4e3).abs() < 0.08, "{hz_peak}");
+    assert!(((hz_freq - 714.0) / 714.0).abs() < 0.08, "{hz_freq}");
+    // Our adaptive law equals Hertz at small overlap (same C_H), so both ring alike;
+    // the seed's 370 Hz for the adaptive model is not reproduced (docs/VALIDATION.md).
+    assert!(
+        ((ad_freq - hz_freq) / hz_freq).abs() < 0.05,
+        "{ad_freq} vs {hz_freq}"
+    );
+    assert!(ad_peak > hz_peak);
+}
+
+#[test]
+fn four_flats_per_wheel_on_both_wheels_run() {
+    let mut s = Scenario::table_4_4();
+    for k in 0..4 {
+        let a = 0.5 + k as f64 * 1.5;
+        s.flats[0].push(FlatSpec::haversine(0.05, 0.0005, a));
+        s.flats[1].push(FlatSpec::haversine(0.06, 0.0008, a + 0.17));
+    }
+    let mut sim = Simulation::new(&s).unwrap();
+    sim.run(0.3, |_| {}).unwrap();
+    let p = sim.max_force();
+    assert!(
+        p[0] > 1.3 * sim.static_load()[0] && p[1] > 1.3 * sim.static_load()[1],
+        "{p:?}"
+    );
+}
+
+fn param_error(s: &Scenario) -> (String, f64) {
+    match Simulation::new(s) {
+        Err(Error::Parameter {
+            name,
+            value,
+            allowed,
+        }) => {
+            assert!(!allowed.is_empty());
+            (name, value)
+        }
+        other => panic!("expected a parameter error, got {:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn non_physical_values_are_refused_with_their_names() {
+    let base = Scenario::table_4_4();
+    let mut s = base.clone();
+    s.set_spans(1);
+    assert_eq!(param_error(&s).0, "track.spans");
+    let mut s = base.clone();
+    if let TrackSpec::Discrete(t) = &mut s.track {
+        t.pad_stiffness = -1.0;
+    }
+    assert_eq!(param_error(&s), ("track.pad.stiffness".into(), -1.0));
+    let mut s = base.clone();
+    if let TrackSpec::Discrete(t) = &mut s.track {
+        t.sleeper_mass = 0.0;
+    }
+    assert_eq!(param_error(&s).0, "track.sleeper.mass");
+    let mut s = base.clone();
+    s.start_position = 100.0;
+    assert_eq!(param_error(&s).0, "start_position");
+    let mut s = base.clone();
+    s.speed = f64::NAN;
+    assert_eq!(param_error(&s).0, "speed");
+    let mut s = base.clone();
+    s.flats[0].push(FlatSpec::haversine(0.1, 0.0, 0.0));
+    assert_eq!(param_error(&s).0, "flat.left[1].depth");
+    let mut s = base.clone();
+    s.flats[1].push(FlatSpec::haversine(1.0, 0.001, 0.0));
+    assert_eq!(param_error(&s).0, "flat.right[1].length");
+    let mut s = base.clone();
+    s.kw = -3.0;
+    assert_eq!(param_error(&s).0, "contact.Kw");
+    let mut s = base.clone();
+    s.dt = 1e-3;
+    match Simulation::new(&s) {
+        Err(e @ Error::UnstableTimeStep { .. }) => {
+            let m = e.to_string();
+            assert!(m.contains("critical step") && m.contains("rail"), "{m}");
+        }
+        other => panic!("{:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn wheel_reaching_the_track_end_stops_the_run() {
+    let mut s = Scenario::table_4_4();
+    s.set_spans(4);
+    s.start_position = 2.0;
+    s.set_nodes_per_span(2);
+    let mut sim = Simulation::new(&s).unwrap();
+    match sim.run(1.0, |_| {}) {
+        Err(Error::OffTrack {
+            position, length, ..
+        }) => {
+            assert!(position >= length && (length - 4.0 * 0.685).abs() < 1e-12);
+        }
+        other => panic!("{other:?}"),
+    }
+}
