@@ -10,6 +10,9 @@
 //! vehicle and the alternative loads), [`solver`] (the coupled time stepping),
 //! [`params`] (the seed's parameter sets).
 
+// Index loops over the two wheels/rails mirror the equations' subscripts.
+#![allow(clippy::needless_range_loop)]
+
 pub mod contact;
 pub mod error;
 pub mod params;

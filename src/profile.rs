@@ -184,7 +184,7 @@ fn validate_flat(radius: f64, spec: &FlatSpec, p: &str) -> Result<Option<Flat>> 
     if length == 0.0 {
         return match depth_given {
             None => Ok(None),
-            Some(d) if d == 0.0 => Ok(None),
+            Some(0.0) => Ok(None),
             Some(d) => Err(out_of_range(
                 &format!("{p}.depth"),
                 d,

@@ -13,6 +13,8 @@ use crate::track::{PointLoad, Track};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
 
 /// Track state of a simulation.
+// Not boxed: the variant is touched every step and there is one per simulation.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum TrackState {
     /// Discrete Timoshenko track.
@@ -22,6 +24,7 @@ pub enum TrackState {
 }
 
 /// Vehicle state of a simulation.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub enum VehicleState {
     /// Six-DOF roll-plane vehicle.
@@ -282,9 +285,9 @@ impl Simulation {
             ],
             _ => [
                 self.law
-                    .evaluate(&self.wheels[0], rotation, rail_z[0] - wheel_z[0]),
+                    .evaluate(&self.wheels[0], gamma, rail_z[0] - wheel_z[0]),
                 self.law
-                    .evaluate(&self.wheels[1], rotation, rail_z[1] - wheel_z[1]),
+                    .evaluate(&self.wheels[1], gamma, rail_z[1] - wheel_z[1]),
             ],
         };
         Sample {
