@@ -325,7 +325,7 @@ fn adaptive(
             };
             let in1 = g(x1) > 0.0;
             if in0 != in1 && nb < MAX_BREAKS {
-                brk[nb] = bisect(&g, x0, x1, in0);
+                brk[nb] = refine_root(&g, x0, x1);
                 nb += 1;
             }
             x0 = x1;
@@ -386,10 +386,9 @@ fn adaptive(
 /// Capacity of the break-point list of one evaluation.
 const MAX_BREAKS: usize = 4 * MAX_FLATS + 2 * BRACKET_SAMPLES + 8;
 
-/// Root of `g` in `[lo, hi]` where `g(lo) > 0` is `inside_lo`, by the Illinois
-/// variant of regula falsi (superlinear), ended at 1e-15 rad.
-fn bisect<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64, inside_lo: bool) -> f64 {
-    let _ = inside_lo;
+/// Root of `g` in `[lo, hi]` (where `g` changes sign) by the Illinois variant of
+/// regula falsi (superlinear), ended at 1e-15 rad.
+fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64) -> f64 {
     let (mut a, mut b) = (lo, hi);
     let (mut fa, mut fb) = (g(a), g(b));
     let mut side = 0i32;

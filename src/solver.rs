@@ -67,6 +67,22 @@ pub struct Simulation {
     min_force: [f64; 2],
 }
 
+/// The two wheel loads `p` (N) at position `x` (m), left and right rail.
+fn wheel_loads(x: f64, p: [f64; 2]) -> [PointLoad; 2] {
+    [
+        PointLoad {
+            rail: 0,
+            position: x,
+            force: p[0],
+        },
+        PointLoad {
+            rail: 1,
+            position: x,
+            force: p[1],
+        },
+    ]
+}
+
 /// Time step used when the scenario asks for the default (`dt = 0`) (s).
 pub fn default_dt(scenario: &Scenario) -> f64 {
     match &scenario.track {
@@ -160,18 +176,7 @@ impl Simulation {
         let p = self.static_load;
         let zr = match &mut self.track {
             TrackState::Discrete(t) => {
-                t.set_static(&[
-                    PointLoad {
-                        rail: 0,
-                        position: x,
-                        force: p[0],
-                    },
-                    PointLoad {
-                        rail: 1,
-                        position: x,
-                        force: p[1],
-                    },
-                ])?;
+                t.set_static(&wheel_loads(x, p))?;
                 [t.rail_z_at(0, x), t.rail_z_at(1, x)]
             }
             TrackState::Lumped(t) => {
@@ -331,18 +336,7 @@ impl Simulation {
             VehicleState::ConstantLoad(_) => {}
         }
         match &mut self.track {
-            TrackState::Discrete(t) => t.step(&[
-                PointLoad {
-                    rail: 0,
-                    position: x,
-                    force: p[0],
-                },
-                PointLoad {
-                    rail: 1,
-                    position: x,
-                    force: p[1],
-                },
-            ]),
+            TrackState::Discrete(t) => t.step(&wheel_loads(x, p)),
             TrackState::Lumped(t) => t.step(p),
         }
         self.steps += 1;

@@ -264,6 +264,16 @@ impl RollPlaneVehicle {
     }
 }
 
+/// One central-difference step of `m z'' + c z' + k (z - z_ref) = f`, `[m, c, k] = mck`,
+/// with the damping velocity centred as in (3.25); returns `z_(j+1)`.
+#[inline]
+fn sdof_step(mck: [f64; 3], dt: f64, z: f64, z_prev: f64, z_ref: f64, f: f64) -> f64 {
+    let [m, c, k] = mck;
+    let a = m / (dt * dt);
+    let b = c / (2.0 * dt);
+    (f - k * (z - z_ref) + a * (2.0 * z - z_prev) + b * z_prev) / (a + b)
+}
+
 /// Chapter-2 lumped wheel (2.27), one per side:
 /// `m_w z'' + C z' + K (z - z_0) = -W + P`, with `z_0` the static position so that the
 /// static contact force is exactly `W` (the suspension preload carries the body).
@@ -327,16 +337,18 @@ impl LumpedWheels {
     /// Advances one step under contact forces `p` (N).
     pub fn step(&mut self, p: [f64; 2]) {
         let q = &self.params;
-        let dt = self.dt;
         for i in 0..2 {
-            let a = q.mass / (dt * dt);
-            let b = q.damping / (2.0 * dt);
-            let rhs = -q.load + p[i] - q.stiffness * (self.z[i] - self.z0[i])
-                + a * (2.0 * self.z[i] - self.z_prev[i])
-                + b * self.z_prev[i];
-            let next = rhs / (a + b);
-            self.z_prev[i] = self.z[i];
-            self.z[i] = next;
+            let (z, zp) = (self.z[i], self.z_prev[i]);
+            let f = -q.load + p[i];
+            self.z[i] = sdof_step(
+                [q.mass, q.damping, q.stiffness],
+                self.dt,
+                z,
+                zp,
+                self.z0[i],
+                f,
+            );
+            self.z_prev[i] = z;
         }
     }
 }
@@ -409,22 +421,11 @@ mod tests {
     use super::*;
     use nalgebra::{DMatrix, SymmetricEigen};
 
-    /// Table 4.4 vehicle.
-    pub(crate) fn table_4_4() -> RollPlaneParams {
-        RollPlaneParams {
-            carbody_mass: 20150.0,
-            bolster_mass: 232.5,
-            bolster_inertia: 87.5,
-            sideframe_mass: 223.75,
-            wheelset_mass: 1120.0,
-            wheelset_inertia: 420.1,
-            primary_stiffness: 6.5e6,
-            primary_damping: 100e3,
-            primary_spacing: 1.6002,
-            secondary_stiffness: 2.55e6,
-            secondary_damping: 44.24e3,
-            secondary_spacing: 1.6002,
-            gravity: 9.81,
+    /// Table 4.4 vehicle, from the preset.
+    fn table_4_4() -> RollPlaneParams {
+        match crate::params::Scenario::table_4_4().vehicle {
+            crate::params::VehicleSpec::RollPlane(p) => p,
+            _ => unreachable!("table 4.4 has the roll-plane vehicle"),
         }
     }
 
