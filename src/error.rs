@@ -40,6 +40,8 @@ pub enum Error {
         /// Simulation time (s).
         time: f64,
     },
+    /// A request this model does not support.
+    Unsupported(String),
 }
 
 impl fmt::Display for Error {
@@ -74,6 +76,7 @@ impl fmt::Display for Error {
             Error::NonFinite { what, time } => {
                 write!(f, "{what} became non-finite at t = {time} s")
             }
+            Error::Unsupported(what) => write!(f, "not supported: {what}"),
         }
     }
 }

@@ -14,6 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod contact;
+pub mod cosim;
 pub mod error;
 pub mod params;
 pub mod profile;

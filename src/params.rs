@@ -32,6 +32,15 @@ pub enum VehicleSpec {
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).
     ConstantLoad([f64; 2]),
+    /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
+    /// displacements and the axle angle are inputs
+    /// ([`crate::solver::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`
+    /// (N) is the load the external vehicle puts on each wheel at rest, used for the
+    /// static start and for calibrating `K_w`.
+    External {
+        /// Static wheel loads `[left, right]` (N).
+        static_load: [f64; 2],
+    },
 }
 
 /// A complete simulation set-up.

@@ -33,6 +33,16 @@ pub enum VehicleState {
     LumpedWheels(LumpedWheels),
     /// Constant loads (N), no contact.
     ConstantLoad([f64; 2]),
+    /// Wheels moved from outside.
+    External {
+        /// Wheel-centre displacements `[left, right]` (m), inputs.
+        wheel_z: [f64; 2],
+        /// Axle rotation angle (rad) given at `since`.
+        rotation: f64,
+        /// Time (s) at which `rotation` was given; between inputs the axle turns at
+        /// `V / R_w`.
+        since: f64,
+    },
 }
 
 /// Everything reported at one instant.
@@ -61,6 +71,13 @@ pub struct Simulation {
     wheels: [WheelProfile; 2],
     law: ContactLaw,
     dt: f64,
+    /// Step asked for by the scenario (or its default) (s): communication steps are
+    /// cut into substeps no longer than this.
+    dt_base: f64,
+    /// Time at which the current step size began (s).
+    t0: f64,
+    /// Steps taken since `t0`.
+    k: u64,
     steps: u64,
     static_load: [f64; 2],
     max_force: [f64; 2],
@@ -140,6 +157,18 @@ impl Simulation {
                 non_negative("load.right", p[1], "N")?;
                 (VehicleState::ConstantLoad(*p), *p)
             }
+            VehicleSpec::External { static_load } => {
+                non_negative("static_load.left", static_load[0], "N")?;
+                non_negative("static_load.right", static_load[1], "N")?;
+                (
+                    VehicleState::External {
+                        wheel_z: [0.0; 2],
+                        rotation: 0.0,
+                        since: 0.0,
+                    },
+                    *static_load,
+                )
+            }
         };
         let law = match s.contact_model {
             ContactModel::Adaptive => {
@@ -159,6 +188,9 @@ impl Simulation {
             wheels,
             law,
             dt,
+            dt_base: dt,
+            t0: 0.0,
+            k: 0,
             steps: 0,
             static_load,
             max_force: [f64::NEG_INFINITY; 2],
@@ -193,6 +225,7 @@ impl Simulation {
             VehicleState::RollPlane(v) => v.set_static(zw),
             VehicleState::LumpedWheels(v) => v.set_static(zw),
             VehicleState::ConstantLoad(_) => {}
+            VehicleState::External { wheel_z, .. } => *wheel_z = zw,
         }
         Ok(())
     }
@@ -203,7 +236,7 @@ impl Simulation {
     }
     /// Current time `t_j` (s).
     pub fn time(&self) -> f64 {
-        self.steps as f64 * self.dt
+        self.t0 + self.k as f64 * self.dt
     }
     /// Steps taken.
     pub fn steps(&self) -> u64 {
@@ -215,7 +248,12 @@ impl Simulation {
     }
     /// Axle rotation angle at the current time (rad) (2.17).
     pub fn rotation(&self) -> f64 {
-        self.scenario.speed * self.time() / self.scenario.wheel_radius
+        match &self.vehicle {
+            VehicleState::External {
+                rotation, since, ..
+            } => *rotation + self.scenario.speed * (self.time() - since) / self.scenario.wheel_radius,
+            _ => self.scenario.speed * self.time() / self.scenario.wheel_radius,
+        }
     }
 
     /// Axle rotation angle wrapped into [0, 2 pi) (rad): what places the flats.
@@ -257,6 +295,32 @@ impl Simulation {
             VehicleState::RollPlane(v) => v.wheel_z(),
             VehicleState::LumpedWheels(v) => v.wheel_z(),
             VehicleState::ConstantLoad(_) => self.rail_z(),
+            VehicleState::External { wheel_z, .. } => *wheel_z,
+        }
+    }
+
+    /// Sets the wheel inputs of a simulation with [`VehicleSpec::External`] wheels:
+    /// wheel-centre displacements `[left, right]` (m) and the axle rotation angle (rad)
+    /// at the current time. Refused for any other vehicle and for non-finite values.
+    pub fn set_wheel_inputs(&mut self, z: [f64; 2], gamma: f64) -> Result<()> {
+        finite("wheel.left.z", z[0], "m")?;
+        finite("wheel.right.z", z[1], "m")?;
+        finite("wheel.rotation", gamma, "rad")?;
+        let now = self.time();
+        match &mut self.vehicle {
+            VehicleState::External {
+                wheel_z,
+                rotation,
+                since,
+            } => {
+                *wheel_z = z;
+                *rotation = gamma;
+                *since = now;
+                Ok(())
+            }
+            _ => Err(Error::Unsupported(
+                "wheel inputs for a simulation that has its own vehicle".into(),
+            )),
         }
     }
 
@@ -333,14 +397,158 @@ impl Simulation {
         match &mut self.vehicle {
             VehicleState::RollPlane(v) => v.step(p),
             VehicleState::LumpedWheels(v) => v.step(p),
-            VehicleState::ConstantLoad(_) => {}
+            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
         }
         match &mut self.track {
             TrackState::Discrete(t) => t.step(&wheel_loads(x, p)),
             TrackState::Lumped(t) => t.step(p),
         }
         self.steps += 1;
+        self.k += 1;
         Ok(s)
+    }
+
+    /// Changes the time step to `dt` (s) from now on (track and vehicle keep their
+    /// displacements and backward-difference velocities). Refused above the track's
+    /// critical step. Only the discrete track with the roll-plane vehicle or constant
+    /// loads supports it.
+    pub fn change_dt(&mut self, dt: f64) -> Result<()> {
+        if dt == self.dt {
+            return Ok(());
+        }
+        match &mut self.track {
+            TrackState::Discrete(t) => t.change_dt(dt)?,
+            TrackState::Lumped(_) => {
+                return Err(Error::Unsupported(
+                    "changing the step of the lumped track".into(),
+                ));
+            }
+        }
+        match &mut self.vehicle {
+            VehicleState::RollPlane(v) => v.change_dt(dt)?,
+            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+            VehicleState::LumpedWheels(_) => {
+                return Err(Error::Unsupported(
+                    "changing the step of the lumped wheels".into(),
+                ));
+            }
+        }
+        self.t0 = self.time();
+        self.k = 0;
+        self.dt = dt;
+        Ok(())
+    }
+
+    /// Advances by a communication step `h` (s): `ceil(h / dt_base)` equal substeps,
+    /// so a step equal to the base step is one engine step, bit for bit. A step whose
+    /// end would carry the wheel off the track is refused before anything moves.
+    pub fn advance(&mut self, h: f64) -> Result<()> {
+        positive("communication step", h, "s")?;
+        if let TrackState::Discrete(t) = &self.track {
+            let len = t.params().length();
+            let end = self.position() + self.scenario.speed * h;
+            if !(end > 0.0 && end < len) {
+                return Err(Error::OffTrack {
+                    position: end,
+                    length: len,
+                    time: self.time() + h,
+                });
+            }
+        }
+        let n = ((h / self.dt_base) * (1.0 - 1e-12)).ceil().max(1.0);
+        let sub = h / n;
+        if sub != self.dt {
+            self.change_dt(sub)?;
+        }
+        for _ in 0..n as u64 {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Everything that determines the continuation (clock, force extremes, track and
+    /// vehicle states); [`Simulation::set_state_vector`] restores it exactly. Only for
+    /// the discrete track with the roll-plane vehicle or constant loads.
+    pub fn state_vector(&self) -> Result<Vec<f64>> {
+        let mut v = vec![
+            self.dt,
+            self.t0,
+            self.k as f64,
+            self.steps as f64,
+            self.max_force[0],
+            self.max_force[1],
+            self.min_force[0],
+            self.min_force[1],
+        ];
+        match &self.track {
+            TrackState::Discrete(t) => v.extend(t.state_vector()),
+            TrackState::Lumped(_) => return Err(Self::no_state()),
+        }
+        match &self.vehicle {
+            VehicleState::RollPlane(r) => v.extend(r.state_vector()),
+            VehicleState::ConstantLoad(_) => {}
+            VehicleState::External {
+                wheel_z,
+                rotation,
+                since,
+            } => v.extend([wheel_z[0], wheel_z[1], *rotation, *since]),
+            VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
+        }
+        Ok(v)
+    }
+
+    fn no_state() -> Error {
+        Error::Unsupported(
+            "state vector of a lumped model (only the discrete track with the roll-plane \
+             vehicle or constant loads has one)"
+                .into(),
+        )
+    }
+
+    /// Restores a state written by [`Simulation::state_vector`] of a simulation built
+    /// from the same scenario.
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        let nt = match &self.track {
+            TrackState::Discrete(t) => t.state_len(),
+            TrackState::Lumped(_) => return Err(Self::no_state()),
+        };
+        let nv = match &self.vehicle {
+            VehicleState::RollPlane(_) => 13,
+            VehicleState::ConstantLoad(_) => 0,
+            VehicleState::External { .. } => 4,
+            VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
+        };
+        if v.len() != 8 + nt + nv {
+            return Err(out_of_range(
+                "simulation state length",
+                v.len() as f64,
+                format!("{} values for this scenario", 8 + nt + nv),
+            ));
+        }
+        if let TrackState::Discrete(t) = &mut self.track {
+            t.set_state_vector(&v[8..8 + nt])?;
+        }
+        match &mut self.vehicle {
+            VehicleState::RollPlane(r) => r.set_state_vector(&v[8 + nt..])?,
+            VehicleState::External {
+                wheel_z,
+                rotation,
+                since,
+            } => {
+                let e = &v[8 + nt..];
+                *wheel_z = [e[0], e[1]];
+                *rotation = e[2];
+                *since = e[3];
+            }
+            _ => {}
+        }
+        self.dt = v[0];
+        self.t0 = v[1];
+        self.k = v[2] as u64;
+        self.steps = v[3] as u64;
+        self.max_force = [v[4], v[5]];
+        self.min_force = [v[6], v[7]];
+        Ok(())
     }
 
     /// Runs until `duration` (s) from now, calling `each` with every sample.

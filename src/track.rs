@@ -267,6 +267,37 @@ struct Coeffs {
     ph_den: f64,
 }
 
+impl Coeffs {
+    /// Update coefficients of the explicit scheme for step `dt` (s).
+    fn new(params: &TrackParams, dt: f64) -> Self {
+            let p = params;
+            let r = &p.rail;
+            let dx = p.dx();
+            let dt2 = dt * dt;
+            let ls = 0.5 * p.rail_seat_distance;
+            let kphi = 2.0 * ls * ls * p.ballast_stiffness;
+            let cphi = 2.0 * ls * ls * p.ballast_damping;
+            Coeffs {
+                zz: r.kag * dt2 / (r.mass * dx * dx),
+                zt: r.kag * dt2 / (2.0 * r.mass * dx),
+                tt: r.ei * dt2 / (r.rotary_inertia * dx * dx),
+                tz: r.kag * dt2 / (2.0 * r.rotary_inertia * dx),
+                t0: r.kag * dt2 / r.rotary_inertia,
+                force: dt2 / (r.mass * dx),
+                kp: p.pad_stiffness,
+                cp_dt: p.pad_damping / dt,
+                zs_a: 2.0 - 2.0 * p.ballast_stiffness * dt2 / p.sleeper_mass,
+                zs_b: p.ballast_damping * dt / p.sleeper_mass - 1.0,
+                zs_f: dt2 / p.sleeper_mass,
+                zs_den: 1.0 / (1.0 + p.ballast_damping * dt / p.sleeper_mass),
+                ph_a: 2.0 - kphi * dt2 / p.sleeper_inertia,
+                ph_b: 0.5 * cphi * dt / p.sleeper_inertia - 1.0,
+                ph_f: ls * dt2 / p.sleeper_inertia,
+                ph_den: 1.0 / (1.0 + 0.5 * cphi * dt / p.sleeper_inertia),
+            }
+    }
+}
+
 /// Track state and its explicit time stepper.
 #[derive(Debug, Clone)]
 pub struct Track {
@@ -421,31 +452,7 @@ impl Track {
     pub(crate) fn new_unchecked(params: TrackParams, dt: f64) -> Self {
         let nk = params.spans * params.nodes_per_span + 1;
         let ns = params.spans + 1;
-        let p = &params;
-        let r = &p.rail;
-        let dx = p.dx();
-        let dt2 = dt * dt;
-        let ls = 0.5 * p.rail_seat_distance;
-        let kphi = 2.0 * ls * ls * p.ballast_stiffness;
-        let cphi = 2.0 * ls * ls * p.ballast_damping;
-        let c = Coeffs {
-            zz: r.kag * dt2 / (r.mass * dx * dx),
-            zt: r.kag * dt2 / (2.0 * r.mass * dx),
-            tt: r.ei * dt2 / (r.rotary_inertia * dx * dx),
-            tz: r.kag * dt2 / (2.0 * r.rotary_inertia * dx),
-            t0: r.kag * dt2 / r.rotary_inertia,
-            force: dt2 / (r.mass * dx),
-            kp: p.pad_stiffness,
-            cp_dt: p.pad_damping / dt,
-            zs_a: 2.0 - 2.0 * p.ballast_stiffness * dt2 / p.sleeper_mass,
-            zs_b: p.ballast_damping * dt / p.sleeper_mass - 1.0,
-            zs_f: dt2 / p.sleeper_mass,
-            zs_den: 1.0 / (1.0 + p.ballast_damping * dt / p.sleeper_mass),
-            ph_a: 2.0 - kphi * dt2 / p.sleeper_inertia,
-            ph_b: 0.5 * cphi * dt / p.sleeper_inertia - 1.0,
-            ph_f: ls * dt2 / p.sleeper_inertia,
-            ph_den: 1.0 / (1.0 + 0.5 * cphi * dt / p.sleeper_inertia),
-        };
+        let c = Coeffs::new(&params, dt);
         Track {
             params,
             dt,
@@ -825,6 +832,96 @@ impl Track {
         self.th.copy_from_slice(th);
         self.z_prev.copy_from_slice(z_prev);
         self.th_prev.copy_from_slice(th_prev);
+    }
+
+    /// Changes the time step to `dt` (s), keeping the displacements at t_j and the
+    /// backward-difference velocities `(x_j - x_(j-1)) / dt`: the t_(j-1) values are
+    /// moved to `x_j - (x_j - x_(j-1)) dt_new / dt_old`. First-order accurate at the
+    /// switch; used when a communication step is not a multiple of the step.
+    pub fn change_dt(&mut self, dt: f64) -> Result<()> {
+        positive("solver.dt", dt, "s")?;
+        if dt > self.dt_critical {
+            return Err(Error::UnstableTimeStep {
+                dt,
+                critical: self.dt_critical,
+                limit: self.params.critical_time_step().1,
+            });
+        }
+        let ratio = dt / self.dt;
+        for (cur, prev) in [
+            (&self.z, &mut self.z_prev),
+            (&self.th, &mut self.th_prev),
+            (&self.zs, &mut self.zs_prev),
+            (&self.ph, &mut self.ph_prev),
+        ] {
+            for (p, c) in prev.iter_mut().zip(cur) {
+                *p = c - (c - *p) * ratio;
+            }
+        }
+        self.c = Coeffs::new(&self.params, dt);
+        self.dt = dt;
+        Ok(())
+    }
+
+    /// Number of values in [`Track::state_vector`].
+    pub fn state_len(&self) -> usize {
+        1 + 8 * self.nk + 6 * self.zs.len()
+    }
+
+    /// Everything that determines the continuation: the step, rails and sleepers at
+    /// t_j and t_(j-1), and the last pad forces. [`Track::set_state_vector`] restores
+    /// it exactly.
+    pub fn state_vector(&self) -> Vec<f64> {
+        let mut v = Vec::with_capacity(self.state_len());
+        v.push(self.dt);
+        for a in [
+            &self.z,
+            &self.th,
+            &self.z_prev,
+            &self.th_prev,
+            &self.zs,
+            &self.ph,
+            &self.zs_prev,
+            &self.ph_prev,
+            &self.pad_left,
+            &self.pad_right,
+        ] {
+            v.extend_from_slice(a);
+        }
+        v
+    }
+
+    /// Restores a state written by [`Track::state_vector`] of a track with the same
+    /// parameters.
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if v.len() != self.state_len() {
+            return Err(out_of_range(
+                "track state length",
+                v.len() as f64,
+                format!("{} values for this grid", self.state_len()),
+            ));
+        }
+        if v[0] != self.dt {
+            self.change_dt(v[0])?;
+        }
+        let mut rest = &v[1..];
+        for a in [
+            &mut self.z,
+            &mut self.th,
+            &mut self.z_prev,
+            &mut self.th_prev,
+            &mut self.zs,
+            &mut self.ph,
+            &mut self.zs_prev,
+            &mut self.ph_prev,
+            &mut self.pad_left,
+            &mut self.pad_right,
+        ] {
+            let (head, tail) = rest.split_at(a.len());
+            a.copy_from_slice(head);
+            rest = tail;
+        }
+        Ok(())
     }
 
     /// Sets sleeper bounce (m) and roll (rad) at t_j and t_(j-1).

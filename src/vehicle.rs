@@ -10,7 +10,7 @@
 //!
 //! Roll angles are positive when they raise the right side (MODEL.md).
 
-use crate::error::{Result, non_negative, positive};
+use crate::error::{Error, Result, non_negative, out_of_range, positive};
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 /// Parameters of the roll-plane vehicle (table 4.4 names).
@@ -127,6 +127,31 @@ impl RollPlaneParams {
         )
     }
 
+    /// Undamped natural angular frequencies (rad/s), ascending: the square roots of
+    /// the eigenvalues of `M^-1 K`, from the symmetric form `M^-1/2 K M^-1/2`.
+    pub fn natural_frequencies(&self) -> [f64; 6] {
+        let s = self.mass_diagonal().map(|m| 1.0 / m.sqrt());
+        let a = Matrix6::from_diagonal(&s) * self.stiffness_matrix() * Matrix6::from_diagonal(&s);
+        let mut w: Vec<f64> = a
+            .symmetric_eigenvalues()
+            .iter()
+            .map(|l| l.max(0.0).sqrt())
+            .collect();
+        w.sort_by(f64::total_cmp);
+        [w[0], w[1], w[2], w[3], w[4], w[5]]
+    }
+
+    /// Critical step of the undamped central-difference scheme, `2 / omega_max` (s).
+    pub fn critical_time_step(&self) -> f64 {
+        2.0 / self.natural_frequencies()[5]
+    }
+
+    /// Default step for the vehicle on its own (s): 50 steps per shortest natural
+    /// period, so the period error of central differences stays below 0.1 %.
+    pub fn default_dt(&self) -> f64 {
+        std::f64::consts::TAU / self.natural_frequencies()[5] / 50.0
+    }
+
     /// Static load on each wheel (N): half the weight of everything (the vehicle is
     /// symmetric about the track centre line).
     pub fn static_wheel_load(&self) -> f64 {
@@ -158,25 +183,94 @@ impl RollPlaneVehicle {
     pub fn new(params: RollPlaneParams, dt: f64) -> Result<Self> {
         params.validate()?;
         positive("solver.dt", dt, "s")?;
+        let critical = params.critical_time_step();
+        if dt > critical {
+            return Err(Error::UnstableTimeStep {
+                dt,
+                critical,
+                limit: "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
+                    .into(),
+            });
+        }
+        let mut v = RollPlaneVehicle {
+            params,
+            dt,
+            d: Vector6::zeros(),
+            d_prev: Vector6::zeros(),
+            p_cur: Matrix6::zeros(),
+            p_prev: Matrix6::zeros(),
+            p_force: Matrix6::zeros(),
+            gravity: params.gravity_force(),
+        };
+        v.set_coefficients(dt);
+        Ok(v)
+    }
+
+    /// Update matrices of (3.25) for step `dt` (s).
+    fn set_coefficients(&mut self, dt: f64) {
+        let params = &self.params;
         let minv = Matrix6::from_diagonal(&params.mass_diagonal().map(|m| 1.0 / m));
         let mc = minv * params.damping_matrix();
         let mk = minv * params.stiffness_matrix();
         let id = Matrix6::<f64>::identity();
         // [I + dt/2 M^-1 C] d+ = dt^2 M^-1 F + [2I - dt^2 M^-1 K] d + [dt/2 M^-1 C - I] d-
-        let lhs = id + mc * (0.5 * dt);
-        let inv = lhs
-            .try_inverse()
-            .expect("I + dt/2 M^-1 C is diagonally dominant");
-        Ok(RollPlaneVehicle {
-            params,
-            dt,
-            d: Vector6::zeros(),
-            d_prev: Vector6::zeros(),
-            p_cur: inv * (id * 2.0 - mk * (dt * dt)),
-            p_prev: inv * (mc * (0.5 * dt) - id),
-            p_force: inv * minv * (dt * dt),
-            gravity: params.gravity_force(),
-        })
+        // I + dt/2 M^-1 C is M^-1 (M + dt/2 C) with M + dt/2 C symmetric positive
+        // definite, hence regular; the identity fallback is never taken.
+        let inv = (id + mc * (0.5 * dt)).try_inverse().unwrap_or(id);
+        self.p_cur = inv * (id * 2.0 - mk * (dt * dt));
+        self.p_prev = inv * (mc * (0.5 * dt) - id);
+        self.p_force = inv * minv * (dt * dt);
+        self.dt = dt;
+    }
+
+    /// Time step (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Changes the time step to `dt` (s), keeping the displacements at t_j and the
+    /// backward-difference velocities (first-order accurate at the switch).
+    pub fn change_dt(&mut self, dt: f64) -> Result<()> {
+        positive("solver.dt", dt, "s")?;
+        let critical = self.params.critical_time_step();
+        if dt > critical {
+            return Err(Error::UnstableTimeStep {
+                dt,
+                critical,
+                limit: "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
+                    .into(),
+            });
+        }
+        let ratio = dt / self.dt;
+        self.d_prev = self.d - (self.d - self.d_prev) * ratio;
+        self.set_coefficients(dt);
+        Ok(())
+    }
+
+    /// Step, displacements at t_j and at t_(j-1): what [`RollPlaneVehicle::set_state_vector`]
+    /// needs to continue exactly.
+    pub fn state_vector(&self) -> Vec<f64> {
+        let mut v = vec![self.dt];
+        v.extend(self.d.iter());
+        v.extend(self.d_prev.iter());
+        v
+    }
+
+    /// Restores a state written by [`RollPlaneVehicle::state_vector`].
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if v.len() != 13 {
+            return Err(out_of_range(
+                "vehicle state length",
+                v.len() as f64,
+                "13 values",
+            ));
+        }
+        if v[0] != self.dt {
+            self.change_dt(v[0])?;
+        }
+        self.d = Vector6::from_column_slice(&v[1..7]);
+        self.d_prev = Vector6::from_column_slice(&v[7..13]);
+        Ok(())
     }
 
     /// Parameters.

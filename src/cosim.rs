@@ -1,0 +1,300 @@
+//! The roll-plane vehicle as a co-simulation unit: driven by contact forces from
+//! outside, it reports wheel displacements and the axle angle. Its partner, the track
+//! with the contact, is a [`crate::solver::Simulation`] with
+//! [`crate::params::VehicleSpec::External`] wheels.
+//!
+//! Coupled with a communication step equal to the track's step, in the order of
+//! `MODEL.md` (vehicle outputs -> track inputs -> track outputs -> vehicle inputs ->
+//! both step), the pair performs exactly the arithmetic of the monolithic
+//! [`crate::solver::Simulation`].
+
+use crate::error::{Error, Result, finite, non_negative, out_of_range, positive};
+use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
+use nalgebra::Vector6;
+
+/// Parameters of a [`VehicleUnit`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VehicleUnitParams {
+    /// The roll-plane vehicle.
+    pub vehicle: RollPlaneParams,
+    /// Forward speed `V` (m/s): turns the axle at `V / R_w`.
+    pub speed: f64,
+    /// Nominal wheel radius `R_w` (m).
+    pub wheel_radius: f64,
+    /// Base step (s); 0 takes [`RollPlaneParams::default_dt`].
+    pub dt: f64,
+    /// Wheel-centre displacements `[left, right]` (m) of the static equilibrium, as the
+    /// track computed them: the vehicle starts at rest on them.
+    pub static_wheel_z: [f64; 2],
+}
+
+/// The six-DOF vehicle stepped by communication steps, with its inputs held.
+#[derive(Debug, Clone)]
+pub struct VehicleUnit {
+    params: VehicleUnitParams,
+    vehicle: RollPlaneVehicle,
+    dt_base: f64,
+    t0: f64,
+    k: u64,
+    force: [f64; 2],
+    max_force: [f64; 2],
+    min_force: [f64; 2],
+}
+
+impl VehicleUnit {
+    /// Builds the vehicle at rest on the static wheel displacements.
+    pub fn new(p: &VehicleUnitParams) -> Result<Self> {
+        finite("speed", p.speed, "m/s")?;
+        if p.speed < 0.0 {
+            return Err(out_of_range("speed", p.speed, ">= 0 m/s"));
+        }
+        positive("wheel.radius", p.wheel_radius, "m")?;
+        non_negative("solver.dt", p.dt, "s")?;
+        finite("static_wheel_z.left", p.static_wheel_z[0], "m")?;
+        finite("static_wheel_z.right", p.static_wheel_z[1], "m")?;
+        p.vehicle.validate()?;
+        let dt = if p.dt == 0.0 {
+            p.vehicle.default_dt()
+        } else {
+            p.dt
+        };
+        let mut vehicle = RollPlaneVehicle::new(p.vehicle, dt)?;
+        vehicle.set_static(p.static_wheel_z);
+        let w = p.vehicle.static_wheel_load();
+        Ok(VehicleUnit {
+            params: *p,
+            vehicle,
+            dt_base: dt,
+            t0: 0.0,
+            k: 0,
+            force: [w, w],
+            max_force: [f64::NEG_INFINITY; 2],
+            min_force: [f64::INFINITY; 2],
+        })
+    }
+
+    /// Parameters.
+    pub fn params(&self) -> &VehicleUnitParams {
+        &self.params
+    }
+    /// Static load on each wheel `[left, right]` (N).
+    pub fn static_load(&self) -> [f64; 2] {
+        let w = self.params.vehicle.static_wheel_load();
+        [w, w]
+    }
+    /// Base step (s).
+    pub fn dt_base(&self) -> f64 {
+        self.dt_base
+    }
+    /// Time (s).
+    pub fn time(&self) -> f64 {
+        self.t0 + self.k as f64 * self.vehicle.dt()
+    }
+    /// Axle rotation angle `V t / R_w` (rad) (2.17).
+    pub fn rotation(&self) -> f64 {
+        self.params.speed * self.time() / self.params.wheel_radius
+    }
+    /// Wheel-centre displacements `[left, right]` (m).
+    pub fn wheel_z(&self) -> [f64; 2] {
+        self.vehicle.wheel_z()
+    }
+    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad).
+    pub fn displacements(&self) -> &Vector6<f64> {
+        self.vehicle.displacements()
+    }
+    /// Primary suspension (bearing) forces `[left, right]` (N), pressing the wheelset down.
+    pub fn bearing_forces(&self) -> [f64; 2] {
+        self.vehicle.bearing_forces()
+    }
+    /// The held contact forces `[left, right]` (N).
+    pub fn forces(&self) -> [f64; 2] {
+        self.force
+    }
+    /// Largest contact force per wheel that has driven a step (N); `-inf` before the
+    /// first step.
+    pub fn max_force(&self) -> [f64; 2] {
+        self.max_force
+    }
+    /// Smallest contact force per wheel that has driven a step (N); `+inf` before the
+    /// first step.
+    pub fn min_force(&self) -> [f64; 2] {
+        self.min_force
+    }
+
+    /// Sets the contact forces `[left, right]` (N) held over the next communication step.
+    pub fn set_forces(&mut self, p: [f64; 2]) -> Result<()> {
+        finite("contact.left.force", p[0], "N")?;
+        finite("contact.right.force", p[1], "N")?;
+        self.force = p;
+        Ok(())
+    }
+
+    /// Advances by a communication step `h` (s) in `ceil(h / dt_base)` equal substeps
+    /// with the contact forces held.
+    pub fn advance(&mut self, h: f64) -> Result<()> {
+        positive("communication step", h, "s")?;
+        let n = ((h / self.dt_base) * (1.0 - 1e-12)).ceil().max(1.0);
+        let sub = h / n;
+        if sub != self.vehicle.dt() {
+            self.t0 = self.time();
+            self.k = 0;
+            self.vehicle.change_dt(sub)?;
+        }
+        for i in 0..2 {
+            self.max_force[i] = self.max_force[i].max(self.force[i]);
+            self.min_force[i] = self.min_force[i].min(self.force[i]);
+        }
+        for _ in 0..n as u64 {
+            self.vehicle.step(self.force);
+            self.k += 1;
+        }
+        let d = self.vehicle.displacements();
+        if !d.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "vehicle displacement".into(),
+                time: self.time(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Everything that determines the continuation; [`VehicleUnit::set_state_vector`]
+    /// restores it exactly.
+    pub fn state_vector(&self) -> Vec<f64> {
+        let mut v = vec![
+            self.t0,
+            self.k as f64,
+            self.force[0],
+            self.force[1],
+            self.max_force[0],
+            self.max_force[1],
+            self.min_force[0],
+            self.min_force[1],
+        ];
+        v.extend(self.vehicle.state_vector());
+        v
+    }
+
+    /// Restores a state written by [`VehicleUnit::state_vector`] of a unit with the
+    /// same parameters.
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if v.len() != 21 {
+            return Err(out_of_range(
+                "vehicle unit state length",
+                v.len() as f64,
+                "21 values",
+            ));
+        }
+        self.vehicle.set_state_vector(&v[8..])?;
+        self.t0 = v[0];
+        self.k = v[1] as u64;
+        self.force = [v[2], v[3]];
+        self.max_force = [v[4], v[5]];
+        self.min_force = [v[6], v[7]];
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{Scenario, VehicleSpec};
+    use crate::solver::Simulation;
+
+    /// Couples an external-wheel track simulation with a vehicle unit, as two FMUs
+    /// would be coupled, and returns the contact forces per step.
+    fn run_pair(s: &Scenario, h_per_dt: f64, steps: usize) -> Vec<[f64; 2]> {
+        let VehicleSpec::RollPlane(vp) = s.vehicle else {
+            panic!("roll-plane scenario expected")
+        };
+        let w = vp.static_wheel_load();
+        let mut ts = s.clone();
+        ts.vehicle = VehicleSpec::External {
+            static_load: [w, w],
+        };
+        let mut track = Simulation::new(&ts).unwrap();
+        let mut veh = VehicleUnit::new(&VehicleUnitParams {
+            vehicle: vp,
+            speed: s.speed,
+            wheel_radius: s.wheel_radius,
+            dt: 0.0,
+            static_wheel_z: track.wheel_z(),
+        })
+        .unwrap();
+        let h = track.dt() * h_per_dt;
+        let mut out = Vec::new();
+        for _ in 0..steps {
+            track
+                .set_wheel_inputs(veh.wheel_z(), veh.rotation())
+                .unwrap();
+            let c = track.sample().contact;
+            let p = [c[0].force, c[1].force];
+            veh.set_forces(p).unwrap();
+            out.push(p);
+            track.advance(h).unwrap();
+            veh.advance(h).unwrap();
+        }
+        out
+    }
+
+    #[test]
+    fn pair_at_the_track_step_is_the_monolithic_solver_bit_for_bit() {
+        let mut s = Scenario::table_4_4_flat();
+        s.set_nodes_per_span(2);
+        s.dt = 45e-6;
+        let steps = 4000; // 0.18 s: passes the first impact of the flat
+        let pair = run_pair(&s, 1.0, steps);
+        let mut sim = Simulation::new(&s).unwrap();
+        let mut peak = 0.0f64;
+        for (j, p) in pair.iter().enumerate() {
+            let m = sim.step().unwrap();
+            assert_eq!(
+                [m.contact[0].force, m.contact[1].force],
+                *p,
+                "step {j} differs"
+            );
+            peak = peak.max(p[0]);
+        }
+        // The run did reach the impact (well above the 107.7 kN static load).
+        assert!(peak > 300e3, "peak {peak}");
+    }
+
+    #[test]
+    fn state_vector_round_trip_continues_identically() {
+        let s = Scenario::table_4_4();
+        let VehicleSpec::RollPlane(vp) = s.vehicle else {
+            unreachable!()
+        };
+        let p = VehicleUnitParams {
+            vehicle: vp,
+            speed: 20.0,
+            wheel_radius: 0.46,
+            dt: 0.0,
+            static_wheel_z: [-1e-3, -1.1e-3],
+        };
+        let mut a = VehicleUnit::new(&p).unwrap();
+        a.set_forces([150e3, 90e3]).unwrap();
+        a.advance(3.3e-3).unwrap();
+        let mut b = VehicleUnit::new(&p).unwrap();
+        b.set_state_vector(&a.state_vector()).unwrap();
+        a.advance(1e-3).unwrap();
+        b.advance(1e-3).unwrap();
+        assert_eq!(a.state_vector(), b.state_vector());
+    }
+
+    #[test]
+    fn vehicle_default_step_resolves_its_fastest_mode() {
+        let s = Scenario::table_4_4();
+        let VehicleSpec::RollPlane(vp) = s.vehicle else {
+            unreachable!()
+        };
+        let w = vp.natural_frequencies();
+        // Free wheelset (rigid-body) modes are zero; the fastest is a wheelset mode on
+        // the primary springs: omega^2 = 2 k1 / m_w bounds it from below.
+        assert!(w[0].abs() < 1e-6 * w[5]);
+        assert!(w[5] >= (2.0 * vp.primary_stiffness / vp.wheelset_mass).sqrt() * 0.999);
+        let dt = vp.default_dt();
+        assert!((dt * w[5] - std::f64::consts::TAU / 50.0).abs() < 1e-12);
+        assert!(dt < vp.critical_time_step());
+    }
+}
