@@ -68,8 +68,8 @@ impl VehicleUnit {
             t0: 0.0,
             k: 0,
             force: [w, w],
-            max_force: [f64::NEG_INFINITY; 2],
-            min_force: [f64::INFINITY; 2],
+            max_force: [w, w],
+            min_force: [w, w],
         })
     }
 
@@ -110,13 +110,13 @@ impl VehicleUnit {
     pub fn forces(&self) -> [f64; 2] {
         self.force
     }
-    /// Largest contact force per wheel that has driven a step (N); `-inf` before the
-    /// first step.
+    /// Largest contact force per wheel that has driven a step (N); the static load
+    /// before the first step.
     pub fn max_force(&self) -> [f64; 2] {
         self.max_force
     }
-    /// Smallest contact force per wheel that has driven a step (N); `+inf` before the
-    /// first step.
+    /// Smallest contact force per wheel that has driven a step (N); the static load
+    /// before the first step.
     pub fn min_force(&self) -> [f64; 2] {
         self.min_force
     }

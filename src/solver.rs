@@ -251,7 +251,9 @@ impl Simulation {
         match &self.vehicle {
             VehicleState::External {
                 rotation, since, ..
-            } => *rotation + self.scenario.speed * (self.time() - since) / self.scenario.wheel_radius,
+            } => {
+                *rotation + self.scenario.speed * (self.time() - since) / self.scenario.wheel_radius
+            }
             _ => self.scenario.speed * self.time() / self.scenario.wheel_radius,
         }
     }

@@ -270,31 +270,31 @@ struct Coeffs {
 impl Coeffs {
     /// Update coefficients of the explicit scheme for step `dt` (s).
     fn new(params: &TrackParams, dt: f64) -> Self {
-            let p = params;
-            let r = &p.rail;
-            let dx = p.dx();
-            let dt2 = dt * dt;
-            let ls = 0.5 * p.rail_seat_distance;
-            let kphi = 2.0 * ls * ls * p.ballast_stiffness;
-            let cphi = 2.0 * ls * ls * p.ballast_damping;
-            Coeffs {
-                zz: r.kag * dt2 / (r.mass * dx * dx),
-                zt: r.kag * dt2 / (2.0 * r.mass * dx),
-                tt: r.ei * dt2 / (r.rotary_inertia * dx * dx),
-                tz: r.kag * dt2 / (2.0 * r.rotary_inertia * dx),
-                t0: r.kag * dt2 / r.rotary_inertia,
-                force: dt2 / (r.mass * dx),
-                kp: p.pad_stiffness,
-                cp_dt: p.pad_damping / dt,
-                zs_a: 2.0 - 2.0 * p.ballast_stiffness * dt2 / p.sleeper_mass,
-                zs_b: p.ballast_damping * dt / p.sleeper_mass - 1.0,
-                zs_f: dt2 / p.sleeper_mass,
-                zs_den: 1.0 / (1.0 + p.ballast_damping * dt / p.sleeper_mass),
-                ph_a: 2.0 - kphi * dt2 / p.sleeper_inertia,
-                ph_b: 0.5 * cphi * dt / p.sleeper_inertia - 1.0,
-                ph_f: ls * dt2 / p.sleeper_inertia,
-                ph_den: 1.0 / (1.0 + 0.5 * cphi * dt / p.sleeper_inertia),
-            }
+        let p = params;
+        let r = &p.rail;
+        let dx = p.dx();
+        let dt2 = dt * dt;
+        let ls = 0.5 * p.rail_seat_distance;
+        let kphi = 2.0 * ls * ls * p.ballast_stiffness;
+        let cphi = 2.0 * ls * ls * p.ballast_damping;
+        Coeffs {
+            zz: r.kag * dt2 / (r.mass * dx * dx),
+            zt: r.kag * dt2 / (2.0 * r.mass * dx),
+            tt: r.ei * dt2 / (r.rotary_inertia * dx * dx),
+            tz: r.kag * dt2 / (2.0 * r.rotary_inertia * dx),
+            t0: r.kag * dt2 / r.rotary_inertia,
+            force: dt2 / (r.mass * dx),
+            kp: p.pad_stiffness,
+            cp_dt: p.pad_damping / dt,
+            zs_a: 2.0 - 2.0 * p.ballast_stiffness * dt2 / p.sleeper_mass,
+            zs_b: p.ballast_damping * dt / p.sleeper_mass - 1.0,
+            zs_f: dt2 / p.sleeper_mass,
+            zs_den: 1.0 / (1.0 + p.ballast_damping * dt / p.sleeper_mass),
+            ph_a: 2.0 - kphi * dt2 / p.sleeper_inertia,
+            ph_b: 0.5 * cphi * dt / p.sleeper_inertia - 1.0,
+            ph_f: ls * dt2 / p.sleeper_inertia,
+            ph_den: 1.0 / (1.0 + 0.5 * cphi * dt / p.sleeper_inertia),
+        }
     }
 }
 

@@ -188,8 +188,9 @@ impl RollPlaneVehicle {
             return Err(Error::UnstableTimeStep {
                 dt,
                 critical,
-                limit: "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
-                    .into(),
+                limit:
+                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
+                        .into(),
             });
         }
         let mut v = RollPlaneVehicle {
@@ -237,8 +238,9 @@ impl RollPlaneVehicle {
             return Err(Error::UnstableTimeStep {
                 dt,
                 critical,
-                limit: "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
-                    .into(),
+                limit:
+                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
+                        .into(),
             });
         }
         let ratio = dt / self.dt;

@@ -1,0 +1,1120 @@
+//! The FMI 2.0 co-simulation layer: an [`Instance`] per FMU instance (state machine,
+//! variable access through the generated table, model building, stepping, FMU
+//! states) in plain Rust, and [`ffi`], the thin C boundary that only converts
+//! pointers, catches panics and forwards to it.
+//!
+//! Three FMUs share one shared library; `fmi2Instantiate` picks the model from the
+//! GUID, which identifies exactly one of them.
+
+pub mod ffi;
+pub mod vars;
+
+use crate::contact::ContactModel;
+use crate::cosim::{VehicleUnit, VehicleUnitParams};
+use crate::error::Error;
+use crate::params::{Scenario, TrackSpec, VehicleSpec};
+use crate::profile::{FlatShape, FlatSpec};
+use crate::solver::{Sample, Simulation, VehicleState};
+use crate::track::{RailEnds, RailSection, TrackParams};
+use crate::vehicle::RollPlaneParams;
+use vars::{Causality, FmuTable, N_VR, VarSpec, VarType, vr};
+
+/// `fmi2Status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[repr(i32)]
+pub enum Status {
+    /// `fmi2OK`
+    Ok = 0,
+    /// `fmi2Warning`
+    Warning = 1,
+    /// `fmi2Discard`
+    Discard = 2,
+    /// `fmi2Error`
+    Error = 3,
+    /// `fmi2Fatal`
+    Fatal = 4,
+    /// `fmi2Pending`
+    Pending = 5,
+}
+
+/// A refused call: the status to return and the message already logged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refusal {
+    /// Status returned to the master.
+    pub status: Status,
+    /// Message sent to the logger.
+    pub message: String,
+}
+
+/// Result of an FMI call.
+pub type FmiResult<T = ()> = std::result::Result<T, Refusal>;
+
+/// Log categories, in the order of the model description.
+pub const LOG_CATEGORIES: [&str; 4] = [
+    "logStatusError",
+    "logStatusWarning",
+    "logCalls",
+    "logEvents",
+];
+
+/// Which of the three FMUs an instance is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Track and contact, wheels as inputs.
+    TrackContact,
+    /// Roll-plane vehicle, contact forces as inputs.
+    RollPlaneVehicle,
+    /// The whole model.
+    CoupledSystem,
+}
+
+impl Kind {
+    /// The FMU with this GUID.
+    pub fn from_guid(guid: &str) -> Option<Kind> {
+        [
+            Kind::TrackContact,
+            Kind::RollPlaneVehicle,
+            Kind::CoupledSystem,
+        ]
+        .into_iter()
+        .find(|k| k.table().guid == guid)
+    }
+    /// Variable table of this FMU.
+    pub fn table(self) -> &'static FmuTable {
+        match self {
+            Kind::TrackContact => &vars::TRACK_CONTACT,
+            Kind::RollPlaneVehicle => &vars::ROLL_PLANE_VEHICLE,
+            Kind::CoupledSystem => &vars::COUPLED_SYSTEM,
+        }
+    }
+}
+
+/// States of the FMI 2.0 co-simulation state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// After `fmi2Instantiate` or `fmi2Reset`.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    Initialization,
+    /// Stepping.
+    StepComplete,
+    /// After `fmi2Terminate`, or after the model ended the run (wheel at the track end).
+    Terminated,
+}
+
+/// The running model behind an instance.
+#[derive(Debug, Clone)]
+enum Model {
+    /// Track and contact (a simulation with external wheels), or the whole system.
+    Sim(Box<Simulation>),
+    /// The vehicle.
+    Vehicle(Box<VehicleUnit>),
+}
+
+/// Values computed when the model is built, published as calculated parameters.
+#[derive(Debug, Clone, Copy, Default)]
+struct Published {
+    static_load: [f64; 2],
+    static_wheel_z: [f64; 2],
+    step: f64,
+    critical_step: f64,
+    kw_used: f64,
+}
+
+/// Everything an FMU state holds: enough to continue bit-identically.
+#[derive(Debug, Clone)]
+pub struct Snapshot {
+    kind: Kind,
+    phase: Phase,
+    values: Vec<f64>,
+    model: Option<Model>,
+    published: Published,
+    time: f64,
+    ended: bool,
+}
+
+/// A logger: status, category, message.
+pub type Logger = Box<dyn FnMut(Status, &str, &str) + Send>;
+
+/// One FMU instance.
+pub struct Instance {
+    kind: Kind,
+    name: String,
+    /// Index into the FMU's variable list for each value reference.
+    slot: Vec<Option<usize>>,
+    /// Current values of parameters and inputs, by value reference.
+    values: Vec<f64>,
+    phase: Phase,
+    model: Option<Model>,
+    /// Parameters changed since the model was built.
+    dirty: bool,
+    published: Published,
+    time: f64,
+    stop_time: Option<f64>,
+    /// The model ended the run (wheel at the track end): `fmi2Terminated` status.
+    ended: bool,
+    logger: Logger,
+    logging_on: bool,
+    categories: [bool; 4],
+}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Instance")
+            .field("kind", &self.kind)
+            .field("name", &self.name)
+            .field("phase", &self.phase)
+            .field("time", &self.time)
+            .finish()
+    }
+}
+
+/// Value references of the flats `[side][k]`: length, depth, angle, shape.
+const FLAT_VRS: [[[u32; 4]; 4]; 2] = [
+    [
+        [
+            vr::FLAT_LEFT_1_LENGTH,
+            vr::FLAT_LEFT_1_DEPTH,
+            vr::FLAT_LEFT_1_ANGLE,
+            vr::FLAT_LEFT_1_SHAPE,
+        ],
+        [
+            vr::FLAT_LEFT_2_LENGTH,
+            vr::FLAT_LEFT_2_DEPTH,
+            vr::FLAT_LEFT_2_ANGLE,
+            vr::FLAT_LEFT_2_SHAPE,
+        ],
+        [
+            vr::FLAT_LEFT_3_LENGTH,
+            vr::FLAT_LEFT_3_DEPTH,
+            vr::FLAT_LEFT_3_ANGLE,
+            vr::FLAT_LEFT_3_SHAPE,
+        ],
+        [
+            vr::FLAT_LEFT_4_LENGTH,
+            vr::FLAT_LEFT_4_DEPTH,
+            vr::FLAT_LEFT_4_ANGLE,
+            vr::FLAT_LEFT_4_SHAPE,
+        ],
+    ],
+    [
+        [
+            vr::FLAT_RIGHT_1_LENGTH,
+            vr::FLAT_RIGHT_1_DEPTH,
+            vr::FLAT_RIGHT_1_ANGLE,
+            vr::FLAT_RIGHT_1_SHAPE,
+        ],
+        [
+            vr::FLAT_RIGHT_2_LENGTH,
+            vr::FLAT_RIGHT_2_DEPTH,
+            vr::FLAT_RIGHT_2_ANGLE,
+            vr::FLAT_RIGHT_2_SHAPE,
+        ],
+        [
+            vr::FLAT_RIGHT_3_LENGTH,
+            vr::FLAT_RIGHT_3_DEPTH,
+            vr::FLAT_RIGHT_3_ANGLE,
+            vr::FLAT_RIGHT_3_SHAPE,
+        ],
+        [
+            vr::FLAT_RIGHT_4_LENGTH,
+            vr::FLAT_RIGHT_4_DEPTH,
+            vr::FLAT_RIGHT_4_ANGLE,
+            vr::FLAT_RIGHT_4_SHAPE,
+        ],
+    ],
+];
+
+impl Instance {
+    /// A new instance of `kind` with start values, logging through `logger`.
+    pub fn new(kind: Kind, name: &str, logger: Logger, logging_on: bool) -> Instance {
+        let table = kind.table();
+        let mut slot = vec![None; N_VR];
+        let mut values = vec![f64::NAN; N_VR];
+        for (i, v) in table.vars.iter().enumerate() {
+            slot[v.vr as usize] = Some(i);
+            values[v.vr as usize] = v.start;
+        }
+        Instance {
+            kind,
+            name: name.to_string(),
+            slot,
+            values,
+            phase: Phase::Instantiated,
+            model: None,
+            dirty: true,
+            published: Published::default(),
+            time: 0.0,
+            stop_time: None,
+            ended: false,
+            logger,
+            logging_on,
+            categories: [true; 4],
+        }
+    }
+
+    /// Which FMU this is.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+    /// Instance name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// State-machine phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+    /// Communication time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    // ---------------------------------------------------------------- logging
+
+    /// Sends a message to the logger: errors and warnings always, the other
+    /// categories when debug logging is on and the category is selected.
+    pub fn log(&mut self, status: Status, category: &str, message: &str) {
+        let idx = LOG_CATEGORIES.iter().position(|c| *c == category);
+        let always = status >= Status::Warning;
+        let on = self.logging_on && idx.is_none_or(|i| self.categories[i]);
+        if always || on {
+            (self.logger)(status, category, message);
+        }
+    }
+
+    /// Logs a call (category `logCalls`) when enabled.
+    pub fn log_call(&mut self, what: impl FnOnce() -> String) {
+        if self.logging_on && self.categories[2] {
+            let m = what();
+            (self.logger)(Status::Ok, "logCalls", &m);
+        }
+    }
+
+    fn log_event(&mut self, what: impl FnOnce() -> String) {
+        if self.logging_on && self.categories[3] {
+            let m = what();
+            (self.logger)(Status::Ok, "logEvents", &m);
+        }
+    }
+
+    /// Logs and returns a refusal.
+    pub fn refuse<T>(&mut self, status: Status, message: String) -> FmiResult<T> {
+        let cat = if status >= Status::Error {
+            "logStatusError"
+        } else {
+            "logStatusWarning"
+        };
+        self.log(status, cat, &message);
+        Err(Refusal { status, message })
+    }
+
+    /// `fmi2SetDebugLogging`: on/off, and the categories to log (all when empty).
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> FmiResult {
+        let mut sel = [categories.is_empty(); 4];
+        for c in categories {
+            match LOG_CATEGORIES.iter().position(|x| x == c) {
+                Some(i) => sel[i] = true,
+                None => {
+                    return self.refuse(
+                        Status::Error,
+                        format!(
+                            "fmi2SetDebugLogging: unknown log category \"{c}\"; the categories are {}",
+                            LOG_CATEGORIES.join(", ")
+                        ),
+                    );
+                }
+            }
+        }
+        self.logging_on = on;
+        self.categories = sel;
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- state machine
+
+    fn require(&mut self, call: &str, allowed: &[Phase]) -> FmiResult {
+        if allowed.contains(&self.phase) {
+            Ok(())
+        } else {
+            let names: Vec<String> = allowed.iter().map(|p| format!("{p:?}")).collect();
+            self.refuse(
+                Status::Error,
+                format!(
+                    "{call} is not allowed in state {:?}; allowed in: {}",
+                    self.phase,
+                    names.join(", ")
+                ),
+            )
+        }
+    }
+
+    /// `fmi2SetupExperiment`.
+    pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> FmiResult {
+        self.require("fmi2SetupExperiment", &[Phase::Instantiated])?;
+        if start != 0.0 || !start.is_finite() {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2SetupExperiment: startTime = {start} s; allowed: 0 s (the model starts in \
+                     static equilibrium at start_position)"
+                ),
+            );
+        }
+        if let Some(t) = stop {
+            if !(t.is_finite() && t > start) {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "fmi2SetupExperiment: stopTime = {t} s; allowed: finite and > startTime"
+                    ),
+                );
+            }
+        }
+        self.stop_time = stop;
+        Ok(())
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> FmiResult {
+        self.require("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
+        self.phase = Phase::Initialization;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: builds the model if parameters changed.
+    pub fn exit_initialization(&mut self) -> FmiResult {
+        self.require("fmi2ExitInitializationMode", &[Phase::Initialization])?;
+        self.ensure_model()?;
+        self.phase = Phase::StepComplete;
+        self.log_event(|| "initialised in static equilibrium".into());
+        Ok(())
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> FmiResult {
+        self.require(
+            "fmi2Terminate",
+            &[
+                Phase::StepComplete,
+                Phase::Terminated,
+                Phase::Initialization,
+            ],
+        )?;
+        self.phase = Phase::Terminated;
+        Ok(())
+    }
+
+    /// `fmi2Reset`: back to the state after instantiation, start values restored.
+    pub fn reset(&mut self) -> FmiResult {
+        for v in self.kind.table().vars {
+            self.values[v.vr as usize] = v.start;
+        }
+        self.phase = Phase::Instantiated;
+        self.model = None;
+        self.dirty = true;
+        self.time = 0.0;
+        self.stop_time = None;
+        self.ended = false;
+        self.published = Published::default();
+        Ok(())
+    }
+
+    /// After an internal error: drop the model and require `fmi2Reset`.
+    pub fn poison(&mut self) {
+        self.model = None;
+        self.dirty = true;
+        self.phase = Phase::Terminated;
+    }
+
+    // ---------------------------------------------------------------- model
+
+    fn v(&self, r: u32) -> f64 {
+        self.values[r as usize]
+    }
+
+    /// Track parameters from the variables.
+    fn track_params(&self) -> TrackParams {
+        TrackParams {
+            spans: self.v(vr::TRACK_SPANS) as usize,
+            nodes_per_span: self.v(vr::TRACK_NODES_PER_SPAN) as usize,
+            sleeper_spacing: self.v(vr::TRACK_SLEEPER_SPACING),
+            rail_seat_distance: self.v(vr::TRACK_RAIL_SEAT_DISTANCE),
+            rail: RailSection {
+                ei: self.v(vr::TRACK_RAIL_EI),
+                kag: self.v(vr::TRACK_RAIL_KAG),
+                mass: self.v(vr::TRACK_RAIL_MASS),
+                rotary_inertia: self.v(vr::TRACK_RAIL_ROTARY_INERTIA),
+            },
+            pad_stiffness: self.v(vr::TRACK_PAD_STIFFNESS),
+            pad_damping: self.v(vr::TRACK_PAD_DAMPING),
+            ballast_stiffness: self.v(vr::TRACK_BALLAST_STIFFNESS),
+            ballast_damping: self.v(vr::TRACK_BALLAST_DAMPING),
+            sleeper_mass: self.v(vr::TRACK_SLEEPER_MASS),
+            sleeper_inertia: self.v(vr::TRACK_SLEEPER_INERTIA),
+            ends: RailEnds::Fixed,
+        }
+    }
+
+    fn vehicle_params(&self) -> RollPlaneParams {
+        RollPlaneParams {
+            carbody_mass: self.v(vr::VEHICLE_CARBODY_MASS),
+            bolster_mass: self.v(vr::VEHICLE_BOLSTER_MASS),
+            bolster_inertia: self.v(vr::VEHICLE_BOLSTER_INERTIA),
+            sideframe_mass: self.v(vr::VEHICLE_SIDEFRAME_MASS),
+            wheelset_mass: self.v(vr::VEHICLE_WHEELSET_MASS),
+            wheelset_inertia: self.v(vr::VEHICLE_WHEELSET_INERTIA),
+            primary_stiffness: self.v(vr::VEHICLE_PRIMARY_STIFFNESS),
+            primary_damping: self.v(vr::VEHICLE_PRIMARY_DAMPING),
+            primary_spacing: self.v(vr::VEHICLE_PRIMARY_SPACING),
+            secondary_stiffness: self.v(vr::VEHICLE_SECONDARY_STIFFNESS),
+            secondary_damping: self.v(vr::VEHICLE_SECONDARY_DAMPING),
+            secondary_spacing: self.v(vr::VEHICLE_SECONDARY_SPACING),
+            gravity: self.v(vr::GRAVITY),
+        }
+    }
+
+    /// The scenario the variables describe (track-carrying FMUs).
+    pub fn scenario(&self) -> Scenario {
+        let flats = [0, 1].map(|side| {
+            FLAT_VRS[side]
+                .iter()
+                .map(|f| {
+                    let depth = self.v(f[1]);
+                    FlatSpec {
+                        length: self.v(f[0]),
+                        depth: if depth == 0.0 { None } else { Some(depth) },
+                        angle: self.v(f[2]),
+                        shape: if self.v(f[3]) == 2.0 {
+                            FlatShape::Chord
+                        } else {
+                            FlatShape::Haversine
+                        },
+                    }
+                })
+                .collect::<Vec<_>>()
+        });
+        let vehicle = match self.kind {
+            Kind::CoupledSystem => VehicleSpec::RollPlane(self.vehicle_params()),
+            _ => VehicleSpec::External {
+                static_load: [self.v(vr::STATIC_LOAD_LEFT), self.v(vr::STATIC_LOAD_RIGHT)],
+            },
+        };
+        Scenario {
+            name: self.kind.table().model_identifier.into(),
+            track: TrackSpec::Discrete(self.track_params()),
+            vehicle,
+            wheel_radius: self.v(vr::WHEEL_RADIUS),
+            flats,
+            contact_model: if self.v(vr::CONTACT_MODEL) == 2.0 {
+                ContactModel::Hertz
+            } else {
+                ContactModel::Adaptive
+            },
+            kw: self.v(vr::CONTACT_KW),
+            hertz_coefficient: self.v(vr::CONTACT_CH),
+            speed: self.v(vr::SPEED),
+            start_position: self.v(vr::START_POSITION),
+            dt: self.v(vr::SOLVER_DT),
+        }
+    }
+
+    fn build(&self) -> crate::Result<(Model, Published)> {
+        match self.kind {
+            Kind::RollPlaneVehicle => {
+                let p = VehicleUnitParams {
+                    vehicle: self.vehicle_params(),
+                    speed: self.v(vr::SPEED),
+                    wheel_radius: self.v(vr::WHEEL_RADIUS),
+                    dt: self.v(vr::SOLVER_DT),
+                    static_wheel_z: [
+                        self.v(vr::STATIC_WHEEL_Z_LEFT),
+                        self.v(vr::STATIC_WHEEL_Z_RIGHT),
+                    ],
+                };
+                let u = VehicleUnit::new(&p)?;
+                let published = Published {
+                    static_load: u.static_load(),
+                    static_wheel_z: p.static_wheel_z,
+                    step: u.dt_base(),
+                    critical_step: p.vehicle.critical_time_step(),
+                    kw_used: 0.0,
+                };
+                Ok((Model::Vehicle(Box::new(u)), published))
+            }
+            _ => {
+                let s = self.scenario();
+                let sim = Simulation::new(&s)?;
+                let critical_step = match &s.track {
+                    TrackSpec::Discrete(t) => t.critical_time_step().0,
+                    TrackSpec::Lumped(_) => f64::NAN,
+                };
+                let published = Published {
+                    static_load: sim.static_load(),
+                    static_wheel_z: sim.wheel_z(),
+                    step: sim.dt(),
+                    critical_step,
+                    kw_used: sim.contact_law().kw,
+                };
+                Ok((Model::Sim(Box::new(sim)), published))
+            }
+        }
+    }
+
+    fn engine_refusal<T>(&mut self, context: &str, e: Error) -> FmiResult<T> {
+        let status = match e {
+            Error::OffTrack { .. } => Status::Discard,
+            _ => Status::Error,
+        };
+        self.refuse(status, format!("{context}: {e}"))
+    }
+
+    /// Builds the model if there is none or parameters changed, and hands it the
+    /// current inputs.
+    fn ensure_model(&mut self) -> FmiResult {
+        if self.model.is_none() || self.dirty {
+            match self.build() {
+                Ok((m, p)) => {
+                    self.model = Some(m);
+                    self.published = p;
+                    self.dirty = false;
+                    self.log_event(|| "model built: static equilibrium solved".into());
+                    self.sync_inputs()?;
+                }
+                Err(e) => {
+                    self.model = None;
+                    return self.engine_refusal("parameters refused", e);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Pushes the input values into the model. Called when inputs are set (and when
+    /// the model is built), not at every step: the track turns the axle on at
+    /// `V / R_w` from the last rotation it was given.
+    fn sync_inputs(&mut self) -> FmiResult {
+        let r = match (&mut self.model, self.kind) {
+            (Some(Model::Sim(sim)), Kind::TrackContact) => sim.set_wheel_inputs(
+                [
+                    self.values[vr::WHEEL_LEFT_Z as usize],
+                    self.values[vr::WHEEL_RIGHT_Z as usize],
+                ],
+                self.values[vr::WHEEL_ROTATION as usize],
+            ),
+            (Some(Model::Vehicle(u)), _) => u.set_forces([
+                self.values[vr::CONTACT_LEFT_FORCE as usize],
+                self.values[vr::CONTACT_RIGHT_FORCE as usize],
+            ]),
+            _ => Ok(()),
+        };
+        match r {
+            Ok(()) => Ok(()),
+            Err(e) => self.engine_refusal("inputs refused", e),
+        }
+    }
+
+    // ---------------------------------------------------------------- variables
+
+    fn spec(&mut self, call: &str, r: u32) -> FmiResult<VarSpec> {
+        match self.slot.get(r as usize).copied().flatten() {
+            Some(i) => Ok(self.kind.table().vars[i]),
+            None => self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: unknown value reference {r} for {}",
+                    self.kind.table().model_identifier
+                ),
+            ),
+        }
+    }
+
+    fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
+        let is_real = s.ty == VarType::Real;
+        if is_real != real {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: variable `{}` (value reference {}) is of type {:?}",
+                    s.name, s.vr, s.ty
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// Reads variables into `out` (Real or Integer/Enumeration by `real`).
+    fn get(&mut self, call: &str, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
+        self.require(
+            call,
+            &[
+                Phase::Initialization,
+                Phase::StepComplete,
+                Phase::Terminated,
+            ],
+        )?;
+        let mut specs = Vec::with_capacity(vrs.len());
+        let mut needs_model = false;
+        for &r in vrs {
+            let s = self.spec(call, r)?;
+            self.check_type(call, &s, real)?;
+            needs_model |= matches!(
+                s.causality,
+                Causality::Output | Causality::CalculatedParameter
+            );
+            specs.push(s);
+        }
+        if needs_model {
+            self.ensure_model()?;
+        }
+        let sample = match &self.model {
+            Some(Model::Sim(sim)) if needs_model => Some(sim.sample()),
+            _ => None,
+        };
+        for (o, s) in out.iter_mut().zip(&specs) {
+            *o = match s.causality {
+                Causality::Parameter | Causality::Input => self.values[s.vr as usize],
+                _ => self.computed(s.vr, sample.as_ref()),
+            };
+        }
+        Ok(())
+    }
+
+    /// Value of an output or calculated parameter.
+    fn computed(&self, r: u32, sample: Option<&Sample>) -> f64 {
+        let p = &self.published;
+        match r {
+            vr::STATIC_LOAD_LEFT => return p.static_load[0],
+            vr::STATIC_LOAD_RIGHT => return p.static_load[1],
+            vr::STATIC_WHEEL_Z_LEFT => return p.static_wheel_z[0],
+            vr::STATIC_WHEEL_Z_RIGHT => return p.static_wheel_z[1],
+            vr::SOLVER_STEP => return p.step,
+            vr::SOLVER_CRITICAL_STEP => return p.critical_step,
+            vr::CONTACT_KW_USED => return p.kw_used,
+            _ => {}
+        }
+        match &self.model {
+            Some(Model::Vehicle(u)) => {
+                let d = u.displacements();
+                match r {
+                    vr::WHEEL_LEFT_Z => u.wheel_z()[0],
+                    vr::WHEEL_RIGHT_Z => u.wheel_z()[1],
+                    vr::WHEEL_ROTATION => u.rotation(),
+                    vr::BOLSTER_Z => d[0],
+                    vr::BOLSTER_ROLL => d[1],
+                    vr::SIDEFRAME_LEFT_Z => d[2],
+                    vr::SIDEFRAME_RIGHT_Z => d[3],
+                    vr::WHEELSET_Z => d[4],
+                    vr::WHEELSET_ROLL => d[5],
+                    vr::PRIMARY_LEFT_FORCE => u.bearing_forces()[0],
+                    vr::PRIMARY_RIGHT_FORCE => u.bearing_forces()[1],
+                    vr::CONTACT_LEFT_MAX_FORCE => u.max_force()[0],
+                    vr::CONTACT_RIGHT_MAX_FORCE => u.max_force()[1],
+                    vr::CONTACT_LEFT_MIN_FORCE => u.min_force()[0],
+                    vr::CONTACT_RIGHT_MIN_FORCE => u.min_force()[1],
+                    _ => f64::NAN,
+                }
+            }
+            Some(Model::Sim(sim)) => {
+                let Some(s) = sample else { return f64::NAN };
+                let c = &s.contact;
+                let vehicle = match sim.vehicle() {
+                    VehicleState::RollPlane(v) => Some(v),
+                    _ => None,
+                };
+                match r {
+                    vr::CONTACT_LEFT_FORCE => c[0].force,
+                    vr::CONTACT_RIGHT_FORCE => c[1].force,
+                    vr::CONTACT_LEFT_OVERLAP => c[0].overlap,
+                    vr::CONTACT_RIGHT_OVERLAP => c[1].overlap,
+                    vr::CONTACT_LEFT_FRONT_ANGLE => c[0].front_angle,
+                    vr::CONTACT_RIGHT_FRONT_ANGLE => c[1].front_angle,
+                    vr::CONTACT_LEFT_REAR_ANGLE => c[0].rear_angle,
+                    vr::CONTACT_RIGHT_REAR_ANGLE => c[1].rear_angle,
+                    vr::CONTACT_LEFT_LENGTH => c[0].length,
+                    vr::CONTACT_RIGHT_LENGTH => c[1].length,
+                    vr::CONTACT_LEFT_INTERVALS => c[0].intervals as f64,
+                    vr::CONTACT_RIGHT_INTERVALS => c[1].intervals as f64,
+                    vr::CONTACT_LEFT_MAX_FORCE => sim.max_force()[0].max(c[0].force),
+                    vr::CONTACT_RIGHT_MAX_FORCE => sim.max_force()[1].max(c[1].force),
+                    vr::CONTACT_LEFT_MIN_FORCE => sim.min_force()[0].min(c[0].force),
+                    vr::CONTACT_RIGHT_MIN_FORCE => sim.min_force()[1].min(c[1].force),
+                    vr::RAIL_LEFT_Z => s.rail_z[0],
+                    vr::RAIL_RIGHT_Z => s.rail_z[1],
+                    vr::POSITION => s.position,
+                    vr::WHEEL_LEFT_Z => s.wheel_z[0],
+                    vr::WHEEL_RIGHT_Z => s.wheel_z[1],
+                    vr::WHEEL_ROTATION => s.rotation,
+                    _ => match vehicle {
+                        Some(v) => {
+                            let d = v.displacements();
+                            match r {
+                                vr::BOLSTER_Z => d[0],
+                                vr::BOLSTER_ROLL => d[1],
+                                vr::SIDEFRAME_LEFT_Z => d[2],
+                                vr::SIDEFRAME_RIGHT_Z => d[3],
+                                vr::WHEELSET_Z => d[4],
+                                vr::WHEELSET_ROLL => d[5],
+                                vr::PRIMARY_LEFT_FORCE => v.bearing_forces()[0],
+                                vr::PRIMARY_RIGHT_FORCE => v.bearing_forces()[1],
+                                _ => f64::NAN,
+                            }
+                        }
+                        None => f64::NAN,
+                    },
+                }
+            }
+            None => f64::NAN,
+        }
+    }
+
+    /// Writes variables (Real or Integer/Enumeration by `real`): every value is checked
+    /// before any is stored, so a refused call changes nothing.
+    fn set(&mut self, call: &str, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
+        self.require(
+            call,
+            &[
+                Phase::Instantiated,
+                Phase::Initialization,
+                Phase::StepComplete,
+            ],
+        )?;
+        let mut specs = Vec::with_capacity(vrs.len());
+        for (&r, &x) in vrs.iter().zip(vals) {
+            let s = self.spec(call, r)?;
+            self.check_type(call, &s, real)?;
+            let settable = match (s.causality, self.phase) {
+                (Causality::Input, _) => true,
+                (Causality::Parameter, Phase::Instantiated | Phase::Initialization) => true,
+                _ => false,
+            };
+            if !settable {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{call}: variable `{}` ({:?}) cannot be set in state {:?}{}",
+                        s.name,
+                        s.causality,
+                        self.phase,
+                        if s.causality == Causality::Parameter {
+                            "; parameters are fixed after initialisation (use fmi2Reset)"
+                        } else {
+                            ""
+                        }
+                    ),
+                );
+            }
+            if !x.is_finite() || x < s.min || x > s.max {
+                let unit = if s.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", s.unit)
+                };
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{call}: `{}` = {x}{unit} is out of range; allowed: finite, {} <= {} <= {}{unit}",
+                        s.name, s.min, s.name, s.max
+                    ),
+                );
+            }
+            specs.push(s);
+        }
+        let mut inputs_changed = false;
+        for (s, &x) in specs.iter().zip(vals) {
+            self.values[s.vr as usize] = x;
+            if s.causality == Causality::Parameter {
+                self.dirty = true;
+            } else {
+                inputs_changed = true;
+            }
+        }
+        if inputs_changed && self.model.is_some() && !self.dirty {
+            self.sync_inputs()?;
+        }
+        Ok(())
+    }
+
+    /// `fmi2GetReal`.
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        self.get("fmi2GetReal", vrs, out, true)
+    }
+
+    /// `fmi2GetInteger` (integers and enumerations).
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
+        let mut tmp = vec![0.0; vrs.len()];
+        self.get("fmi2GetInteger", vrs, &mut tmp, false)?;
+        for (o, t) in out.iter_mut().zip(tmp) {
+            *o = t as i32;
+        }
+        Ok(())
+    }
+
+    /// `fmi2SetReal`.
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> FmiResult {
+        self.set("fmi2SetReal", vrs, vals, true)
+    }
+
+    /// `fmi2SetInteger` (integers and enumerations).
+    pub fn set_integer(&mut self, vrs: &[u32], vals: &[i32]) -> FmiResult {
+        let tmp: Vec<f64> = vals.iter().map(|&x| x as f64).collect();
+        self.set("fmi2SetInteger", vrs, &tmp, false)
+    }
+
+    /// Boolean and String access: these FMUs have no such variables, so any value
+    /// reference is unknown (an empty request succeeds in every state but Instantiated
+    /// for reads).
+    pub fn no_such_type(&mut self, call: &str, vrs: &[u32]) -> FmiResult {
+        match vrs.first() {
+            None => Ok(()),
+            Some(r) => self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: unknown value reference {r}: {} has no variables of this type",
+                    self.kind.table().model_identifier
+                ),
+            ),
+        }
+    }
+
+    // ---------------------------------------------------------------- stepping
+
+    /// `fmi2DoStep` from `t` (s) by `h` (s).
+    pub fn do_step(&mut self, t: f64, h: f64) -> FmiResult {
+        self.require("fmi2DoStep", &[Phase::StepComplete])?;
+        if !(h.is_finite() && h > 0.0) {
+            return self.refuse(
+                Status::Error,
+                format!("fmi2DoStep: communicationStepSize = {h} s; allowed: finite and > 0 s"),
+            );
+        }
+        let tol = 1e-9 * (1.0 + self.time.abs());
+        if !t.is_finite() || (t - self.time).abs() > tol {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: currentCommunicationPoint = {t} s, but the FMU is at {} s",
+                    self.time
+                ),
+            );
+        }
+        let r = match &mut self.model {
+            Some(Model::Sim(sim)) => sim.advance(h),
+            Some(Model::Vehicle(u)) => u.advance(h),
+            None => Err(Error::Unsupported("stepping before initialisation".into())),
+        };
+        if let Err(e) = r {
+            if matches!(e, Error::OffTrack { .. }) {
+                self.ended = true;
+            }
+            return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
+        }
+        self.time = t + h;
+        Ok(())
+    }
+
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    pub fn last_successful_time(&self) -> f64 {
+        self.time
+    }
+
+    /// `fmi2GetBooleanStatus(fmi2Terminated)`: the model ended the run.
+    pub fn terminated_by_model(&self) -> bool {
+        self.ended
+    }
+
+    // ---------------------------------------------------------------- FMU states
+
+    /// `fmi2GetFMUstate`.
+    pub fn get_state(&mut self) -> FmiResult<Snapshot> {
+        let t = self.time;
+        self.log_event(|| format!("state saved at t = {t} s"));
+        Ok(Snapshot {
+            kind: self.kind,
+            phase: self.phase,
+            values: self.values.clone(),
+            model: self.model.clone(),
+            published: self.published,
+            time: self.time,
+            ended: self.ended,
+        })
+    }
+
+    /// `fmi2SetFMUstate`.
+    pub fn set_state(&mut self, s: &Snapshot) -> FmiResult {
+        if s.kind != self.kind {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2SetFMUstate: the state belongs to {:?}, this instance is {:?}",
+                    s.kind, self.kind
+                ),
+            );
+        }
+        self.phase = s.phase;
+        self.values.clone_from(&s.values);
+        self.model.clone_from(&s.model);
+        self.dirty = self.model.is_none();
+        self.published = s.published;
+        self.time = s.time;
+        self.ended = s.ended;
+        let t = self.time;
+        self.log_event(|| format!("state restored at t = {t} s"));
+        Ok(())
+    }
+
+    /// `fmi2SerializeFMUstate`: magic, GUID, phase, clock, values, model state.
+    pub fn serialize(&mut self, s: &Snapshot) -> FmiResult<Vec<u8>> {
+        let model = match &s.model {
+            None => Vec::new(),
+            Some(Model::Vehicle(u)) => u.state_vector(),
+            Some(Model::Sim(sim)) => match sim.state_vector() {
+                Ok(v) => v,
+                Err(e) => return self.engine_refusal("fmi2SerializeFMUstate", e),
+            },
+        };
+        let mut b = Vec::new();
+        b.extend_from_slice(MAGIC);
+        let guid = s.kind.table().guid.as_bytes();
+        b.extend_from_slice(&(guid.len() as u64).to_le_bytes());
+        b.extend_from_slice(guid);
+        b.push(s.phase as u8);
+        b.push(s.ended as u8);
+        b.push(s.model.is_some() as u8);
+        b.extend_from_slice(&s.time.to_le_bytes());
+        for x in [
+            s.published.static_load[0],
+            s.published.static_load[1],
+            s.published.static_wheel_z[0],
+            s.published.static_wheel_z[1],
+            s.published.step,
+            s.published.critical_step,
+            s.published.kw_used,
+        ] {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+        b.extend_from_slice(&(s.values.len() as u64).to_le_bytes());
+        for x in &s.values {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+        b.extend_from_slice(&(model.len() as u64).to_le_bytes());
+        for x in &model {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+        Ok(b)
+    }
+
+    /// `fmi2DeSerializeFMUstate`: rebuilds the model from the stored parameters, then
+    /// puts the stored dynamic state into it.
+    pub fn deserialize(&mut self, bytes: &[u8]) -> FmiResult<Snapshot> {
+        match self.decode(bytes) {
+            Ok(s) => Ok(s),
+            Err(m) => self.refuse(Status::Error, format!("fmi2DeSerializeFMUstate: {m}")),
+        }
+    }
+
+    fn decode(&mut self, bytes: &[u8]) -> std::result::Result<Snapshot, String> {
+        let mut r = Cursor { b: bytes, at: 0 };
+        if r.take(MAGIC.len())? != MAGIC {
+            return Err("not a wheelflat FMU state (bad magic)".into());
+        }
+        let n = r.u64()? as usize;
+        let guid = r.take(n)?;
+        if guid != self.kind.table().guid.as_bytes() {
+            return Err(format!(
+                "the state was written by another FMU (GUID {}), not {} {}",
+                String::from_utf8_lossy(guid),
+                self.kind.table().model_identifier,
+                self.kind.table().guid
+            ));
+        }
+        let phase = match r.take(1)?[0] {
+            0 => Phase::Instantiated,
+            1 => Phase::Initialization,
+            2 => Phase::StepComplete,
+            3 => Phase::Terminated,
+            p => return Err(format!("bad phase {p}")),
+        };
+        let ended = r.take(1)?[0] != 0;
+        let has_model = r.take(1)?[0] != 0;
+        let time = r.f64()?;
+        let mut pubs = [0.0; 7];
+        for x in &mut pubs {
+            *x = r.f64()?;
+        }
+        let nv = r.u64()? as usize;
+        if nv != N_VR {
+            return Err(format!("{nv} values; this FMU has {N_VR}"));
+        }
+        let mut values = Vec::with_capacity(nv);
+        for _ in 0..nv {
+            values.push(r.f64()?);
+        }
+        let nm = r.u64()? as usize;
+        if nm > bytes.len() / 8 {
+            return Err(format!("model state length {nm} exceeds the data"));
+        }
+        let mut state = Vec::with_capacity(nm);
+        for _ in 0..nm {
+            state.push(r.f64()?);
+        }
+        if r.at != bytes.len() {
+            return Err(format!("{} trailing bytes", bytes.len() - r.at));
+        }
+        let model = if has_model {
+            // Build with the stored parameters on a scratch instance, then overwrite
+            // the dynamic state.
+            let saved = std::mem::replace(&mut self.values, values.clone());
+            let built = self.build();
+            self.values = saved;
+            let (mut m, _) = built.map_err(|e| format!("stored parameters refused: {e}"))?;
+            match &mut m {
+                Model::Vehicle(u) => u.set_state_vector(&state),
+                Model::Sim(sim) => sim.set_state_vector(&state),
+            }
+            .map_err(|e| e.to_string())?;
+            Some(m)
+        } else {
+            None
+        };
+        Ok(Snapshot {
+            kind: self.kind,
+            phase,
+            values,
+            model,
+            published: Published {
+                static_load: [pubs[0], pubs[1]],
+                static_wheel_z: [pubs[2], pubs[3]],
+                step: pubs[4],
+                critical_step: pubs[5],
+                kw_used: pubs[6],
+            },
+            time,
+            ended,
+        })
+    }
+}
+
+const MAGIC: &[u8] = b"wheelflat-fmu-state-1\0";
+
+struct Cursor<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn take(&mut self, n: usize) -> std::result::Result<&'a [u8], String> {
+        if self.at + n > self.b.len() {
+            return Err(format!("truncated at byte {}", self.at));
+        }
+        let s = &self.b[self.at..self.at + n];
+        self.at += n;
+        Ok(s)
+    }
+    fn u64(&mut self) -> std::result::Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+    fn f64(&mut self) -> std::result::Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+}
