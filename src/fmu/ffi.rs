@@ -87,15 +87,15 @@ unsafe impl Send for CLogger {}
 impl CLogger {
     fn log(&self, status: Status, category: &str, message: &str) {
         let cat = CString::new(category.replace('\0', " ")).unwrap_or_default();
-        let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
-        // The message goes through "%s" so that a '%' in it is never a format.
+        // The message is the format string, with '%' doubled: masters that format it
+        // (printf-style) and masters that print it as it is both show the text.
+        let msg = CString::new(message.replace('\0', " ").replace('%', "%%")).unwrap_or_default();
         unsafe {
             (self.logger)(
                 self.env,
                 self.name.as_ptr(),
                 status as c_int,
                 cat.as_ptr(),
-                c"%s".as_ptr(),
                 msg.as_ptr(),
             )
         }

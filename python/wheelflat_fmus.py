@@ -1,0 +1,146 @@
+"""Helpers for the wheelflat FMUs: a local virtual environment with fmpy, building the
+FMUs with cargo, and the coupling of TrackContact with RollPlaneVehicle through fmpy's
+FMU2Slave in the order of MODEL.md.
+
+The static-equilibrium handshake (in initialization mode):
+  1. vehicle -> track: ``static_load.left``, ``static_load.right`` (N);
+  2. track -> vehicle: ``static_wheel_z.left``, ``static_wheel_z.right`` (m).
+Then each communication point: vehicle outputs -> track inputs -> track outputs ->
+vehicle inputs -> both step.
+"""
+
+import os
+import subprocess
+import sys
+import venv
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+VENV = os.path.join(ROOT, ".venv")
+REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
+FMU_DIR = os.path.join(ROOT, "fmu")
+
+
+def venv_python():
+    return os.path.join(VENV, "bin", "python")
+
+
+def ensure_venv():
+    """Re-runs the current script inside .venv, creating it (with the pinned packages
+    of python/requirements.txt) when needed."""
+    if os.path.realpath(sys.prefix) == os.path.realpath(VENV):
+        return
+    stamp = os.path.join(VENV, ".requirements")
+    wanted = open(REQUIREMENTS).read()
+    if not (os.path.exists(stamp) and open(stamp).read() == wanted):
+        print("setting up .venv (fmpy, numpy, matplotlib, pytest) ...", file=sys.stderr)
+        if not os.path.exists(venv_python()):
+            venv.create(VENV, with_pip=True)
+        subprocess.check_call([venv_python(), "-m", "pip", "install", "-q", "-r", REQUIREMENTS])
+        with open(stamp, "w") as f:
+            f.write(wanted)
+    os.execv(venv_python(), [venv_python()] + sys.argv)
+
+
+def build_fmus():
+    """Builds the shared library and packs fmu/*.fmu (cargo, release profile)."""
+    subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "build_fmus"], cwd=ROOT)
+    subprocess.check_call([os.path.join(ROOT, "target", "release", "build_fmus"), FMU_DIR], cwd=ROOT,
+                          stdout=subprocess.DEVNULL)
+    return {name: os.path.join(FMU_DIR, name + ".fmu") for name in ("TrackContact", "RollPlaneVehicle", "CoupledSystem")}
+
+
+def value_references(model_description):
+    return {v.name: v.valueReference for v in model_description.modelVariables}
+
+
+class Unit:
+    """One FMU instance through fmpy's FMU2Slave."""
+
+    def __init__(self, path, instance_name, callbacks=None, logging_on=False):
+        from fmpy import extract, read_model_description
+        from fmpy.fmi2 import FMU2Slave
+
+        self.md = read_model_description(path)
+        self.dir = extract(path)
+        self.vr = value_references(self.md)
+        self.types = {v.name: v.type for v in self.md.modelVariables}
+        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
+                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance_name)
+        self.fmu.instantiate(callbacks=callbacks, loggingOn=logging_on)
+
+    def get(self, *names):
+        return list(self.fmu.getReal([self.vr[n] for n in names]))
+
+    def set(self, names, values):
+        self.fmu.setReal([self.vr[n] for n in names], list(values))
+
+    def set_parameters(self, params):
+        """Sets parameters by name (Real, or Integer/Enumeration by their declared type)."""
+        for name, value in (params or {}).items():
+            if self.types[name] in ("Integer", "Enumeration"):
+                self.fmu.setInteger([self.vr[name]], [int(value)])
+            else:
+                self.fmu.setReal([self.vr[name]], [float(value)])
+
+    def close(self):
+        import shutil
+        try:
+            self.fmu.terminate()
+        finally:
+            self.fmu.freeInstance()
+            shutil.rmtree(self.dir, ignore_errors=True)
+
+
+WHEELS = ("wheel.left.z", "wheel.right.z", "wheel.rotation")
+FORCES = ("contact.left.force", "contact.right.force")
+TRACK_RECORD = ("contact.left.force", "contact.right.force", "contact.left.max_force", "contact.right.max_force",
+                "rail.left.z", "rail.right.z", "position")
+
+
+def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
+    """Parameters, static-equilibrium handshake and the first exchange."""
+    for u in (track, vehicle):
+        u.fmu.setupExperiment(startTime=0.0)
+    track.set_parameters(track_params)
+    vehicle.set_parameters(vehicle_params)
+    vehicle.fmu.enterInitializationMode()
+    track.fmu.enterInitializationMode()
+    loads = ("static_load.left", "static_load.right")
+    track.set(loads, vehicle.get(*loads))
+    heights = ("static_wheel_z.left", "static_wheel_z.right")
+    vehicle.set(heights, track.get(*heights))
+    track.set(WHEELS, vehicle.get(*WHEELS))
+    vehicle.set(FORCES, track.get(*FORCES))
+    vehicle.fmu.exitInitializationMode()
+    track.fmu.exitInitializationMode()
+
+
+def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params=None):
+    """Couples TrackContact and RollPlaneVehicle; comm_step None takes the track's
+    internal step (``solver.step``), which reproduces CoupledSystem exactly.
+    Returns a dict of lists: time, the TRACK_RECORD outputs and the wheel outputs."""
+    track = Unit(paths["TrackContact"], "track")
+    vehicle = Unit(paths["RollPlaneVehicle"], "vehicle")
+    try:
+        initialise_pair(track, vehicle, track_params, vehicle_params)
+        h = comm_step if comm_step is not None else track.get("solver.step")[0]
+        n = int(round(stop_time / h))
+        out = {k: [] for k in ("time",) + TRACK_RECORD + WHEELS}
+        t = 0.0
+        for k in range(n + 1):
+            z = vehicle.get(*WHEELS)
+            track.set(WHEELS, z)
+            rec = track.get(*TRACK_RECORD)
+            vehicle.set(FORCES, rec[:2])
+            out["time"].append(t)
+            for name, x in zip(TRACK_RECORD + WHEELS, rec + z):
+                out[name].append(x)
+            if k == n:
+                break
+            track.fmu.doStep(t, h)
+            vehicle.fmu.doStep(t, h)
+            t = (k + 1) * h
+        return out
+    finally:
+        track.close()
+        vehicle.close()
