@@ -56,12 +56,15 @@ def value_references(model_description):
 class Unit:
     """One FMU instance through fmpy's FMU2Slave."""
 
-    def __init__(self, path, instance_name, callbacks=None, logging_on=False):
+    def __init__(self, path, instance_name, callbacks=None, logging_on=False, unzip_dir=None):
+        """unzip_dir: an already extracted FMU to share (its shared library is then
+        loaded once for all units that share it); by default each unit extracts its own."""
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
         self.md = read_model_description(path)
-        self.dir = extract(path)
+        self.owns_dir = unzip_dir is None
+        self.dir = extract(path) if unzip_dir is None else unzip_dir
         self.vr = value_references(self.md)
         self.types = {v.name: v.type for v in self.md.modelVariables}
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
@@ -88,13 +91,27 @@ class Unit:
             self.fmu.terminate()
         finally:
             self.fmu.freeInstance()
-            shutil.rmtree(self.dir, ignore_errors=True)
+            if self.owns_dir:
+                shutil.rmtree(self.dir, ignore_errors=True)
 
 
 WHEELS = ("wheel.left.z", "wheel.right.z", "wheel.rotation")
 FORCES = ("contact.left.force", "contact.right.force")
 TRACK_RECORD = ("contact.left.force", "contact.right.force", "contact.left.max_force", "contact.right.max_force",
                 "rail.left.z", "rail.right.z", "position")
+
+
+def track_step(paths, track_params=None):
+    """The track's internal step ``solver.step`` (s) for these parameters."""
+    u = Unit(paths["TrackContact"], "probe")
+    try:
+        u.fmu.setupExperiment(startTime=0.0)
+        u.set_parameters(track_params)
+        u.fmu.enterInitializationMode()
+        return u.get("solver.step")[0]
+    finally:
+        u.fmu.terminate()
+        u.close()
 
 
 def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
