@@ -24,11 +24,9 @@ def venv_python():
     return os.path.join(VENV, "bin", "python")
 
 
-def ensure_venv():
-    """Re-runs the current script inside .venv, creating it (with the pinned packages
-    of python/requirements.txt) when needed."""
-    if os.path.realpath(sys.prefix) == os.path.realpath(VENV):
-        return
+def install_venv():
+    """Creates .venv with the pinned packages of python/requirements.txt, or brings it
+    up to date when the requirements changed."""
     stamp = os.path.join(VENV, ".requirements")
     wanted = open(REQUIREMENTS).read()
     if not (os.path.exists(stamp) and open(stamp).read() == wanted):
@@ -38,6 +36,13 @@ def ensure_venv():
         subprocess.check_call([venv_python(), "-m", "pip", "install", "-q", "-r", REQUIREMENTS])
         with open(stamp, "w") as f:
             f.write(wanted)
+
+
+def ensure_venv():
+    """Re-runs the current script inside .venv (installed when needed)."""
+    if os.path.realpath(sys.prefix) == os.path.realpath(VENV):
+        return
+    install_venv()
     os.execv(venv_python(), [venv_python()] + sys.argv)
 
 
@@ -161,3 +166,7 @@ def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params
     finally:
         track.close()
         vehicle.close()
+
+
+if __name__ == "__main__":
+    install_venv()

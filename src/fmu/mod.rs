@@ -361,15 +361,11 @@ impl Instance {
                 ),
             );
         }
-        if let Some(t) = stop {
-            if !(t.is_finite() && t > start) {
-                return self.refuse(
-                    Status::Error,
-                    format!(
-                        "fmi2SetupExperiment: stopTime = {t} s; allowed: finite and > startTime"
-                    ),
-                );
-            }
+        if let Some(t) = stop.filter(|t| !(t.is_finite() && *t > start)) {
+            return self.refuse(
+                Status::Error,
+                format!("fmi2SetupExperiment: stopTime = {t} s; allowed: finite and > startTime"),
+            );
         }
         self.stop_time = stop;
         Ok(())
@@ -783,11 +779,14 @@ impl Instance {
         for (&r, &x) in vrs.iter().zip(vals) {
             let s = self.spec(call, r)?;
             self.check_type(call, &s, real)?;
-            let settable = match (s.causality, self.phase) {
-                (Causality::Input, _) => true,
-                (Causality::Parameter, Phase::Instantiated | Phase::Initialization) => true,
-                _ => false,
-            };
+            let settable = matches!(
+                (s.causality, self.phase),
+                (Causality::Input, _)
+                    | (
+                        Causality::Parameter,
+                        Phase::Instantiated | Phase::Initialization
+                    )
+            );
             if !settable {
                 return self.refuse(
                     Status::Error,
@@ -895,6 +894,18 @@ impl Instance {
                 format!(
                     "fmi2DoStep: currentCommunicationPoint = {t} s, but the FMU is at {} s",
                     self.time
+                ),
+            );
+        }
+        if let Some(stop) = self
+            .stop_time
+            .filter(|s| t + h > s + 1e-9 * (1.0 + s.abs()))
+        {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: t + h = {} s is past stopTime = {stop} s of fmi2SetupExperiment",
+                    t + h
                 ),
             );
         }

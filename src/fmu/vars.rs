@@ -59,7 +59,13 @@ pub struct FmuTable {
     pub vars: &'static [VarSpec],
 }
 
-include!(concat!(env!("OUT_DIR"), "/variables.rs"));
+// Start values are the table's literal numbers (pi/2 among them).
+#[allow(clippy::approx_constant)]
+mod generated {
+    use super::{Causality, FmuTable, VarSpec, VarType};
+    include!(concat!(env!("OUT_DIR"), "/variables.rs"));
+}
+pub use generated::*;
 
 /// The three FMUs.
 pub static FMUS: [&FmuTable; 3] = [&TRACK_CONTACT, &ROLL_PLANE_VEHICLE, &COUPLED_SYSTEM];

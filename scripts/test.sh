@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The project's test command (README.md); CI runs it through .ci/run.
+# Needs only Rust, Python 3.11 with pip and a C compiler; Python packages go into .venv.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== Rust: format, lints, engine and FMI-layer tests"
+cargo fmt --check
+cargo clippy --all-targets -- -D warnings
+cargo build --release
+cargo test --release
+
+echo "== FMUs: pack fmu/*.fmu and the C header"
+./target/release/build_fmus fmu
+
+echo "== Python: .venv with fmpy, then the FMU tests"
+python3 python/wheelflat_fmus.py
+.venv/bin/python -m pytest -q tests/test_fmus.py
+
+echo "== Rust: the FMUs through an independent importer (the fmi crate)"
+# bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
+# the C compiler's own headers.
+LIBCLANG_PATH="$PWD/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)" \
+BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)" \
+    cargo test --manifest-path tests/fmi_import/Cargo.toml
