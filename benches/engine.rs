@@ -75,5 +75,76 @@ fn contact(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, reference, scaling, contact);
+/// TrackContact through its C functions, at communication step = dt (set the wheel
+/// inputs, read the contact forces, step: what a master does each step), against the
+/// engine stepping the same track with the same held wheels.
+fn fmu_step(c: &mut Criterion) {
+    use std::ffi::CString;
+    use wheelflat::fmu::ffi::*;
+    use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
+    use wheelflat::params::VehicleSpec;
+
+    let mut g = c.benchmark_group("track_contact_per_0.1s");
+    g.sample_size(10);
+    // The engine: the default scenario with external wheels held at rest.
+    let mut s = Scenario::table_4_4_flat();
+    s.vehicle = VehicleSpec::External {
+        static_load: [107_664.75; 2],
+    };
+    let sim = Simulation::new(&s).unwrap();
+    let (z, dt) = (sim.wheel_z(), sim.dt());
+    let n = (SIM_TIME / dt).round() as u64;
+    g.bench_function("engine_step", |b| {
+        b.iter(|| {
+            let mut e = sim.clone();
+            for k in 0..n {
+                e.set_wheel_inputs(z, e.rotation()).unwrap();
+                black_box(e.step().unwrap());
+                black_box(k);
+            }
+        })
+    });
+    // The FMU.
+    let cb = fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let guid = CString::new(TRACK_CONTACT.guid).unwrap();
+    let comp =
+        unsafe { fmi2Instantiate(c"bench".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0) };
+    assert!(!comp.is_null());
+    let mut state: fmi2FMUstate = std::ptr::null_mut();
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(comp, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2EnterInitializationMode(comp), 0);
+        assert_eq!(fmi2ExitInitializationMode(comp), 0);
+        assert_eq!(fmi2GetFMUstate(comp, &mut state), 0);
+    }
+    let inputs = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
+    let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
+    g.bench_function("fmi2_set_get_dostep", |b| {
+        b.iter(|| unsafe {
+            assert_eq!(fmi2SetFMUstate(comp, state), 0);
+            let mut p = [0.0; 2];
+            for k in 0..n {
+                let t = k as f64 * dt;
+                let u = [z[0], z[1], s.speed * t / s.wheel_radius];
+                fmi2SetReal(comp, inputs.as_ptr(), 3, u.as_ptr());
+                fmi2GetReal(comp, outputs.as_ptr(), 2, p.as_mut_ptr());
+                black_box(p);
+                fmi2DoStep(comp, t, dt, 1);
+            }
+        })
+    });
+    unsafe {
+        fmi2FreeFMUstate(comp, &mut state);
+        fmi2FreeInstance(comp);
+    }
+    g.finish();
+}
+
+criterion_group!(benches, reference, scaling, contact, fmu_step);
 criterion_main!(benches);

@@ -11,6 +11,7 @@ use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
 use crate::track::{PointLoad, Track};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use std::cell::Cell;
 
 /// Track state of a simulation.
 // Not boxed: the variant is touched every step and there is one per simulation.
@@ -82,6 +83,9 @@ pub struct Simulation {
     static_load: [f64; 2],
     max_force: [f64; 2],
     min_force: [f64; 2],
+    /// The sample at the current time and inputs, once computed (a co-simulation
+    /// master reads the outputs and then steps: the contact is evaluated once).
+    cached: Cell<Option<Sample>>,
 }
 
 /// The two wheel loads `p` (N) at position `x` (m), left and right rail.
@@ -195,6 +199,7 @@ impl Simulation {
             static_load,
             max_force: [f64::NEG_INFINITY; 2],
             min_force: [f64::INFINITY; 2],
+            cached: Cell::new(None),
         };
         sim.set_static()?;
         Ok(sim)
@@ -204,6 +209,7 @@ impl Simulation {
     /// loads from the vehicle, track deflection under them (direct solve), overlaps
     /// from the inverse contact law, then the vehicle resting on those wheel heights.
     fn set_static(&mut self) -> Result<()> {
+        self.cached.set(None);
         let x = self.scenario.start_position;
         let p = self.static_load;
         let zr = match &mut self.track {
@@ -318,6 +324,7 @@ impl Simulation {
                 *wheel_z = z;
                 *rotation = gamma;
                 *since = now;
+                self.cached.set(None);
                 Ok(())
             }
             _ => Err(Error::Unsupported(
@@ -337,6 +344,15 @@ impl Simulation {
 
     /// Everything at the current time, contact forces included.
     pub fn sample(&self) -> Sample {
+        if let Some(s) = self.cached.get() {
+            return s;
+        }
+        let s = self.compute_sample();
+        self.cached.set(Some(s));
+        s
+    }
+
+    fn compute_sample(&self) -> Sample {
         let wheel_z = self.wheel_z();
         let rail_z = self.rail_z();
         let rotation = self.rotation();
@@ -405,6 +421,7 @@ impl Simulation {
             TrackState::Discrete(t) => t.step(&wheel_loads(x, p)),
             TrackState::Lumped(t) => t.step(p),
         }
+        self.cached.set(None);
         self.steps += 1;
         self.k += 1;
         Ok(s)
@@ -438,6 +455,7 @@ impl Simulation {
         self.t0 = self.time();
         self.k = 0;
         self.dt = dt;
+        self.cached.set(None);
         Ok(())
     }
 
@@ -550,6 +568,7 @@ impl Simulation {
         self.steps = v[3] as u64;
         self.max_force = [v[4], v[5]];
         self.min_force = [v[6], v[7]];
+        self.cached.set(None);
         Ok(())
     }
 

@@ -625,6 +625,11 @@ impl Instance {
         }
     }
 
+    /// The spec of a value reference already checked by [`Instance::spec`].
+    fn known_spec(&self, r: u32) -> VarSpec {
+        self.kind.table().vars[self.slot[r as usize].unwrap_or_default()]
+    }
+
     fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
         let is_real = s.ty == VarType::Real;
         if is_real != real {
@@ -667,7 +672,8 @@ impl Instance {
             Some(Model::Sim(sim)) if needs_model => Some(sim.sample()),
             _ => None,
         };
-        for (o, s) in out.iter_mut().zip(&specs) {
+        for (o, &r) in out.iter_mut().zip(vrs) {
+            let s = self.known_spec(r);
             *o = match s.causality {
                 Causality::Parameter | Causality::Input => self.values[s.vr as usize],
                 _ => self.computed(s.vr, sample.as_ref()),
@@ -775,7 +781,6 @@ impl Instance {
                 Phase::StepComplete,
             ],
         )?;
-        let mut specs = Vec::with_capacity(vrs.len());
         for (&r, &x) in vrs.iter().zip(vals) {
             let s = self.spec(call, r)?;
             self.check_type(call, &s, real)?;
@@ -817,10 +822,10 @@ impl Instance {
                     ),
                 );
             }
-            specs.push(s);
         }
         let mut inputs_changed = false;
-        for (s, &x) in specs.iter().zip(vals) {
+        for (&r, &x) in vrs.iter().zip(vals) {
+            let s = self.known_spec(r);
             self.values[s.vr as usize] = x;
             if s.causality == Causality::Parameter {
                 self.dirty = true;
@@ -1127,5 +1132,97 @@ impl<'a> Cursor<'a> {
     }
     fn f64(&mut self) -> std::result::Result<f64, String> {
         Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    fn instance(kind: Kind) -> (Instance, Arc<Mutex<Vec<String>>>) {
+        let log = Arc::new(Mutex::new(Vec::new()));
+        let l2 = log.clone();
+        let logger: Logger = Box::new(move |_, _, m| l2.lock().unwrap().push(m.to_string()));
+        (Instance::new(kind, "test", logger, false), log)
+    }
+
+    #[test]
+    fn default_start_values_are_the_reference_scenario() {
+        let (i, _) = instance(Kind::CoupledSystem);
+        let mut a = Simulation::new(&i.scenario()).unwrap();
+        let mut b = Simulation::new(&Scenario::table_4_4_flat()).unwrap();
+        for _ in 0..3000 {
+            assert_eq!(a.step().unwrap(), b.step().unwrap());
+        }
+        // The literal handshake defaults of the table equal what the models compute.
+        let w = match Scenario::table_4_4().vehicle {
+            VehicleSpec::RollPlane(p) => p.static_wheel_load(),
+            _ => unreachable!(),
+        };
+        let (t, _) = instance(Kind::TrackContact);
+        assert_eq!(t.v(vr::STATIC_LOAD_LEFT), w);
+        let sim = Simulation::new(&t.scenario()).unwrap();
+        assert_eq!(t.v(vr::WHEEL_LEFT_Z), sim.wheel_z()[0]);
+        let (v, _) = instance(Kind::RollPlaneVehicle);
+        assert_eq!(v.v(vr::STATIC_WHEEL_Z_LEFT), sim.wheel_z()[0]);
+        assert_eq!(v.v(vr::CONTACT_LEFT_FORCE), w);
+    }
+
+    #[test]
+    fn every_variable_is_documented() {
+        let doc = include_str!("../../docs/VARIABLES.md");
+        for t in vars::FMUS {
+            for v in t.vars {
+                assert!(
+                    doc.contains(&format!("| `{}` |", v.name)),
+                    "{} undocumented",
+                    v.name
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn refusals_name_the_variable_and_leave_the_instance_usable() {
+        let (mut i, log) = instance(Kind::TrackContact);
+        assert!(i.do_step(0.0, 1e-5).is_err());
+        let e = i.set_real(&[vr::TRACK_PAD_STIFFNESS], &[-1.0]).unwrap_err();
+        assert_eq!(e.status, Status::Error);
+        assert!(
+            e.message.contains("`track.pad.stiffness` = -1 N/m"),
+            "{}",
+            e.message
+        );
+        assert_eq!(
+            i.v(vr::TRACK_PAD_STIFFNESS),
+            140e6,
+            "a refused set changes nothing"
+        );
+        let e = i.set_integer(&[vr::TRACK_SPANS], &[1]).unwrap_err();
+        assert!(e.message.contains("`track.spans` = 1"), "{}", e.message);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 1e-4).unwrap();
+        let mut p = [0.0];
+        i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+        assert!((p[0] - 107.66e3).abs() < 2e3);
+        assert_eq!(log.lock().unwrap().len(), 3, "each refusal logged once");
+    }
+
+    #[test]
+    fn track_rotation_input_is_held_then_turns_at_speed_over_radius() {
+        let (mut i, _) = instance(Kind::TrackContact);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        let sim = |i: &Instance| match &i.model {
+            Some(Model::Sim(s)) => s.rotation(),
+            _ => unreachable!(),
+        };
+        i.set_real(&[vr::WHEEL_ROTATION], &[0.5]).unwrap();
+        assert_eq!(sim(&i), 0.5);
+        i.do_step(0.0, 1e-3).unwrap();
+        let expected = 0.5 + 1e-3 * (70.0 / 3.6) / 0.475;
+        assert!((sim(&i) - expected).abs() < 1e-12);
     }
 }
