@@ -7,7 +7,11 @@ use std::path::PathBuf;
 
 fn fmu(name: &str) -> Fmi2Import {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../fmu/{name}.fmu"));
-    assert!(path.exists(), "{} missing: build the FMUs first (scripts/test.sh does)", path.display());
+    assert!(
+        path.exists(),
+        "{} missing: build the FMUs first (scripts/test.sh does)",
+        path.display()
+    );
     fmi::import::from_path(&path).expect("fmi crate imports the FMU")
 }
 
@@ -72,9 +76,18 @@ fn track_contact_forces_are_direct_feedthrough() {
     let dz = 1e-7;
     inst.set_real(&[z], &[zs[0] - dz]).unwrap();
     inst.get_real(&[force, overlap], &mut p).unwrap();
-    assert!((p[1] - (d0 + dz)).abs() < 1e-12, "overlap {} -> {}", d0, p[1]);
+    assert!(
+        (p[1] - (d0 + dz)).abs() < 1e-12,
+        "overlap {} -> {}",
+        d0,
+        p[1]
+    );
     let expected = 1.5 * p0 / d0 * dz;
-    assert!(((p[0] - p0) - expected).abs() < 0.02 * expected, "{p0} -> {} (expected +{expected})", p[0]);
+    assert!(
+        ((p[0] - p0) - expected).abs() < 0.02 * expected,
+        "{p0} -> {} (expected +{expected})",
+        p[0]
+    );
     inst.do_step(0.0, 1e-4, true).unwrap();
     inst.terminate().unwrap();
 }
