@@ -20,6 +20,6 @@ python3 python/wheelflat_fmus.py
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
 # bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
 # the C compiler's own headers.
-LIBCLANG_PATH="$PWD/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)" \
+LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)" \
 BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)" \
     cargo test --manifest-path tests/fmi_import/Cargo.toml
