@@ -146,6 +146,21 @@ impl RollPlaneParams {
         2.0 / self.natural_frequencies()[5]
     }
 
+    /// Refuses a step above [`RollPlaneParams::critical_time_step`].
+    pub fn check_time_step(&self, dt: f64) -> Result<()> {
+        let critical = self.critical_time_step();
+        if dt > critical {
+            return Err(Error::UnstableTimeStep {
+                dt,
+                critical,
+                limit:
+                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
+                        .into(),
+            });
+        }
+        Ok(())
+    }
+
     /// Default step for the vehicle on its own (s): 50 steps per shortest natural
     /// period, so the period error of central differences stays below 0.1 %.
     pub fn default_dt(&self) -> f64 {
@@ -183,16 +198,7 @@ impl RollPlaneVehicle {
     pub fn new(params: RollPlaneParams, dt: f64) -> Result<Self> {
         params.validate()?;
         positive("solver.dt", dt, "s")?;
-        let critical = params.critical_time_step();
-        if dt > critical {
-            return Err(Error::UnstableTimeStep {
-                dt,
-                critical,
-                limit:
-                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
-                        .into(),
-            });
-        }
+        params.check_time_step(dt)?;
         let mut v = RollPlaneVehicle {
             params,
             dt,
@@ -233,16 +239,7 @@ impl RollPlaneVehicle {
     /// backward-difference velocities (first-order accurate at the switch).
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
         positive("solver.dt", dt, "s")?;
-        let critical = self.params.critical_time_step();
-        if dt > critical {
-            return Err(Error::UnstableTimeStep {
-                dt,
-                critical,
-                limit:
-                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
-                        .into(),
-            });
-        }
+        self.params.check_time_step(dt)?;
         let ratio = dt / self.dt;
         self.d_prev = self.d - (self.d - self.d_prev) * ratio;
         self.set_coefficients(dt);

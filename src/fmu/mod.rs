@@ -696,27 +696,16 @@ impl Instance {
             _ => {}
         }
         match &self.model {
-            Some(Model::Vehicle(u)) => {
-                let d = u.displacements();
-                match r {
-                    vr::WHEEL_LEFT_Z => u.wheel_z()[0],
-                    vr::WHEEL_RIGHT_Z => u.wheel_z()[1],
-                    vr::WHEEL_ROTATION => u.rotation(),
-                    vr::BOLSTER_Z => d[0],
-                    vr::BOLSTER_ROLL => d[1],
-                    vr::SIDEFRAME_LEFT_Z => d[2],
-                    vr::SIDEFRAME_RIGHT_Z => d[3],
-                    vr::WHEELSET_Z => d[4],
-                    vr::WHEELSET_ROLL => d[5],
-                    vr::PRIMARY_LEFT_FORCE => u.bearing_forces()[0],
-                    vr::PRIMARY_RIGHT_FORCE => u.bearing_forces()[1],
-                    vr::CONTACT_LEFT_MAX_FORCE => u.max_force()[0],
-                    vr::CONTACT_RIGHT_MAX_FORCE => u.max_force()[1],
-                    vr::CONTACT_LEFT_MIN_FORCE => u.min_force()[0],
-                    vr::CONTACT_RIGHT_MIN_FORCE => u.min_force()[1],
-                    _ => f64::NAN,
-                }
-            }
+            Some(Model::Vehicle(u)) => match r {
+                vr::WHEEL_LEFT_Z => u.wheel_z()[0],
+                vr::WHEEL_RIGHT_Z => u.wheel_z()[1],
+                vr::WHEEL_ROTATION => u.rotation(),
+                vr::CONTACT_LEFT_MAX_FORCE => u.max_force()[0],
+                vr::CONTACT_RIGHT_MAX_FORCE => u.max_force()[1],
+                vr::CONTACT_LEFT_MIN_FORCE => u.min_force()[0],
+                vr::CONTACT_RIGHT_MIN_FORCE => u.min_force()[1],
+                _ => body_output(r, u.displacements(), || u.bearing_forces()),
+            },
             Some(Model::Sim(sim)) => {
                 let Some(s) = sample else { return f64::NAN };
                 let c = &s.contact;
@@ -748,20 +737,7 @@ impl Instance {
                     vr::WHEEL_RIGHT_Z => s.wheel_z[1],
                     vr::WHEEL_ROTATION => s.rotation,
                     _ => match vehicle {
-                        Some(v) => {
-                            let d = v.displacements();
-                            match r {
-                                vr::BOLSTER_Z => d[0],
-                                vr::BOLSTER_ROLL => d[1],
-                                vr::SIDEFRAME_LEFT_Z => d[2],
-                                vr::SIDEFRAME_RIGHT_Z => d[3],
-                                vr::WHEELSET_Z => d[4],
-                                vr::WHEELSET_ROLL => d[5],
-                                vr::PRIMARY_LEFT_FORCE => v.bearing_forces()[0],
-                                vr::PRIMARY_RIGHT_FORCE => v.bearing_forces()[1],
-                                _ => f64::NAN,
-                            }
-                        }
+                        Some(v) => body_output(r, v.displacements(), || v.bearing_forces()),
                         None => f64::NAN,
                     },
                 }
@@ -1108,6 +1084,22 @@ impl Instance {
             time,
             ended,
         })
+    }
+}
+
+/// Vehicle body outputs from the displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`
+/// and the bearing forces; NaN for any other reference.
+fn body_output(r: u32, d: &nalgebra::Vector6<f64>, bearing: impl Fn() -> [f64; 2]) -> f64 {
+    match r {
+        vr::BOLSTER_Z => d[0],
+        vr::BOLSTER_ROLL => d[1],
+        vr::SIDEFRAME_LEFT_Z => d[2],
+        vr::SIDEFRAME_RIGHT_Z => d[3],
+        vr::WHEELSET_Z => d[4],
+        vr::WHEELSET_ROLL => d[5],
+        vr::PRIMARY_LEFT_FORCE => bearing()[0],
+        vr::PRIMARY_RIGHT_FORCE => bearing()[1],
+        _ => f64::NAN,
     }
 }
 
