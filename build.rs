@@ -320,11 +320,19 @@ fn main() {
                 kinds.join(" ")
             )
         };
-        let outputs: Vec<&FmuVar> = fv.iter().filter(|v| v.causality() == "output").collect();
-        if !outputs.is_empty() {
-            md.push_str("    <Outputs>\n");
-            for v in &outputs {
-                let d = expand(v.get("dependencies"), true);
+        // One <Unknown> list: Outputs (dependencies on inputs) or InitialUnknowns
+        // (dependencies on the knowns of initialization mode).
+        let mut unknowns = |tag: &str, causalities: &[&str], attr: &str, inputs_only: bool| {
+            let list: Vec<&FmuVar> = fv
+                .iter()
+                .filter(|v| causalities.contains(&v.causality()))
+                .collect();
+            if list.is_empty() {
+                return;
+            }
+            writeln!(md, "    <{tag}>").unwrap();
+            for v in list {
+                let d = expand(v.get(attr), inputs_only);
                 writeln!(
                     md,
                     "      <Unknown index=\"{}\"{}/>",
@@ -333,26 +341,15 @@ fn main() {
                 )
                 .unwrap();
             }
-            md.push_str("    </Outputs>\n");
-        }
-        let initial: Vec<&FmuVar> = fv
-            .iter()
-            .filter(|v| matches!(v.causality(), "output" | "calculatedParameter"))
-            .collect();
-        if !initial.is_empty() {
-            md.push_str("    <InitialUnknowns>\n");
-            for v in &initial {
-                let d = expand(v.get("initialDependencies"), false);
-                writeln!(
-                    md,
-                    "      <Unknown index=\"{}\"{}/>",
-                    index[v.name()],
-                    deps_attr(&d)
-                )
-                .unwrap();
-            }
-            md.push_str("    </InitialUnknowns>\n");
-        }
+            writeln!(md, "    </{tag}>").unwrap();
+        };
+        unknowns("Outputs", &["output"], "dependencies", true);
+        unknowns(
+            "InitialUnknowns",
+            &["output", "calculatedParameter"],
+            "initialDependencies",
+            false,
+        );
         md.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
         let g = guid(&md);
         let md = md.replace("@GUID@", &g);

@@ -515,9 +515,10 @@ impl Track {
         }
     }
 
-    /// Sets every displacement (at t_j and t_(j-1)) to zero.
-    pub fn reset(&mut self) {
-        for v in [
+    /// The state arrays in the order of [`Track::state_vector`]: rails and sleepers at
+    /// t_j and t_(j-1), then the pad forces.
+    fn state_arrays_mut(&mut self) -> [&mut Vec<f64>; 10] {
+        [
             &mut self.z,
             &mut self.th,
             &mut self.z_prev,
@@ -528,7 +529,12 @@ impl Track {
             &mut self.ph_prev,
             &mut self.pad_left,
             &mut self.pad_right,
-        ] {
+        ]
+    }
+
+    /// Sets every displacement (at t_j and t_(j-1)) to zero.
+    pub fn reset(&mut self) {
+        for v in self.state_arrays_mut() {
             v.iter_mut().for_each(|x| *x = 0.0);
         }
     }
@@ -905,18 +911,7 @@ impl Track {
             self.change_dt(v[0])?;
         }
         let mut rest = &v[1..];
-        for a in [
-            &mut self.z,
-            &mut self.th,
-            &mut self.z_prev,
-            &mut self.th_prev,
-            &mut self.zs,
-            &mut self.ph,
-            &mut self.zs_prev,
-            &mut self.ph_prev,
-            &mut self.pad_left,
-            &mut self.pad_right,
-        ] {
+        for a in self.state_arrays_mut() {
             let (head, tail) = rest.split_at(a.len());
             a.copy_from_slice(head);
             rest = tail;
