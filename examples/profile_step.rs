@@ -1,15 +1,21 @@
-//! Times the parts of one coupled step of the reference case (seed grid).
+//! Times the parts of one coupled step of the reference case at the seed grid
+//! (n = 2, dt = 45 us, 30 spans): the track step alone at every SIMD level this CPU
+//! has, and the whole coupled step. Levels are timed in interleaved rounds and the
+//! fastest round is kept, which is what a noisy shared machine allows.
+//! `cargo run --release --example profile_step`
+use std::hint::black_box;
 use std::time::Instant;
 use wheelflat::params::{Scenario, TrackSpec};
-use wheelflat::track::{PointLoad, Track};
+use wheelflat::solver::Simulation;
+use wheelflat::track::{PointLoad, SimdLevel, Track};
 
 fn main() {
     let mut s = Scenario::table_4_4_flat();
     s.set_nodes_per_span(2);
+    s.dt = 45e-6;
     let TrackSpec::Discrete(p) = s.track else {
         unreachable!()
     };
-    let mut t = Track::new(p, 45e-6).unwrap();
     let loads = [
         PointLoad {
             rail: 0,
@@ -22,52 +28,59 @@ fn main() {
             force: 1e5,
         },
     ];
-    let n = 200_000;
-    let t0 = Instant::now();
-    for _ in 0..n {
-        t.step(std::hint::black_box(&loads));
+    let levels = SimdLevel::available();
+    let mut tracks: Vec<Track> = levels
+        .iter()
+        .map(|l| {
+            let mut t = Track::new(p, 45e-6).unwrap();
+            t.set_simd(*l).unwrap();
+            t
+        })
+        .collect();
+    let mut best = vec![f64::INFINITY; levels.len()];
+    let n = 20_000;
+    for _round in 0..15 {
+        for (t, b) in tracks.iter_mut().zip(best.iter_mut()) {
+            let t0 = Instant::now();
+            for _ in 0..n {
+                t.step(black_box(&loads));
+            }
+            *b = b.min(t0.elapsed().as_secs_f64() / n as f64);
+        }
     }
-    let per = t0.elapsed().as_secs_f64() / n as f64;
-    println!(
-        "track step: {:.1} ns ({} nodes per rail) -> {:.2} ms per simulated s at 45 us",
-        per * 1e9,
-        t.nodes(),
-        per / 45e-6 * 1e3
-    );
-    let z = t.rail_z(0);
-    let subn = |v: &[f64]| {
-        v.iter()
-            .filter(|v| v.abs() < 2.3e-308 && **v != 0.0)
-            .count()
-    };
-    let sub = subn(z) + subn(t.rail_z(1)) + subn(t.rail_theta(0)) + subn(t.rail_theta(1));
-    println!(
-        "subnormal sleeper bounce {}, roll {}",
-        subn(t.sleeper_z()),
-        subn(t.sleeper_roll())
-    );
-    println!("subnormal rail values: {sub}");
-    let mut t2 = Track::new(p, 45e-6).unwrap();
-    let t0 = Instant::now();
-    for _ in 0..n {
-        t2.step(std::hint::black_box(&[]));
+    for (l, b) in levels.iter().zip(&best) {
+        println!(
+            "track step {:>9}: {:6.1} ns ({} nodes per rail) -> {:.2} ms per simulated s",
+            format!("{l:?}"),
+            b * 1e9,
+            tracks[0].nodes(),
+            b / 45e-6 * 1e3
+        );
+    }
+    let sim = Simulation::new(&s).unwrap();
+    let mut perfect = s.clone();
+    perfect.flats = [vec![], vec![]];
+    let sim_p = Simulation::new(&perfect).unwrap();
+    let steps = (0.3 / sim.dt()) as usize;
+    let (mut bf, mut bp) = (f64::INFINITY, f64::INFINITY);
+    for _round in 0..10 {
+        for (sim, b) in [(&sim, &mut bf), (&sim_p, &mut bp)] {
+            let mut a = sim.clone();
+            let t0 = Instant::now();
+            for _ in 0..steps {
+                black_box(a.step().unwrap());
+            }
+            *b = b.min(t0.elapsed().as_secs_f64() / steps as f64);
+        }
     }
     println!(
-        "track step, zero state: {:.1} ns",
-        t0.elapsed().as_secs_f64() / n as f64 * 1e9
+        "coupled step, reference flat: {:.1} ns -> {:.2} ms per simulated s",
+        bf * 1e9,
+        bf / 45e-6 * 1e3
     );
-    let sim = wheelflat::solver::Simulation::new(&{
-        let mut s = s.clone();
-        s.flats = [vec![], vec![]];
-        s.dt = 45e-6;
-        s
-    })
-    .unwrap();
-    let mut a = sim.clone();
-    let t0 = Instant::now();
-    for _ in 0..n / 10 {
-        std::hint::black_box(a.step().unwrap());
-    }
-    let per = t0.elapsed().as_secs_f64() / (n / 10) as f64;
-    println!("coupled step, perfect wheels: {:.1} ns", per * 1e9);
+    println!(
+        "coupled step, perfect wheels: {:.1} ns -> {:.2} ms per simulated s",
+        bp * 1e9,
+        bp / 45e-6 * 1e3
+    );
 }

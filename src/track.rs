@@ -298,17 +298,67 @@ impl Coeffs {
     }
 }
 
+/// Vector instructions the track stepper's loops run with. The level is detected
+/// once when a track is built ([`SimdLevel::detect`]); [`Track::set_simd`] picks
+/// another (for benchmarks and for checking that the levels agree). No FMA is used,
+/// so every level gives bit-identical results. Ordered narrowest first.
+///
+/// There is no AVX-512 level: on the Xeon (Sapphire Rapids) machines we run on, the
+/// same loops compiled for AVX-512F took 352 ns per track step against 266 ns with
+/// AVX2 (reference case, n = 2; `examples/profile_step`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SimdLevel {
+    /// Whatever the build target allows (SSE2 on x86-64).
+    Baseline,
+    /// AVX2: 4 lanes of f64.
+    Avx2,
+}
+
+impl SimdLevel {
+    /// The widest level this CPU supports.
+    pub fn detect() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return SimdLevel::Avx2;
+            }
+        }
+        SimdLevel::Baseline
+    }
+
+    /// Every level this CPU supports, narrowest first.
+    pub fn available() -> Vec<Self> {
+        let top = Self::detect();
+        [SimdLevel::Baseline, SimdLevel::Avx2]
+            .into_iter()
+            .filter(|l| *l <= top)
+            .collect()
+    }
+}
+
 /// Track state and its explicit time stepper.
+///
+/// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
+/// contiguous memory. Node `k` of rail `r` sits in block `k % n` (block length
+/// `2 N_s`, `N_s = N + 1` sleepers) at `r N_s + k / n`; block 0 therefore holds the
+/// rail nodes above the sleepers, left rail then right rail, in sleeper order, and the
+/// sleeper loop reads it directly. Blocks `1..n` have one unused slot per rail (there
+/// are `N` bays, not `N + 1`), kept at zero. Accessors return node order.
 #[derive(Debug, Clone)]
 pub struct Track {
     params: TrackParams,
     dt: f64,
     dt_critical: f64,
+    /// Nodes per rail `K + 1`.
     nk: usize,
+    /// Sleepers `N_s = N + 1`.
+    ns: usize,
     c: Coeffs,
-    /// Rail deflection at t_j, both rails end to end (left nodes 0..=K, right 0..=K).
+    /// Storage slot of node `k` of the left rail (add `N_s` for the right rail).
+    slot: Vec<usize>,
+    /// Rail deflection at t_j (m), phase-blocked.
     z: Vec<f64>,
-    /// Rail rotation at t_j.
+    /// Rail rotation at t_j (rad), phase-blocked.
     th: Vec<f64>,
     z_prev: Vec<f64>,
     th_prev: Vec<f64>,
@@ -316,35 +366,36 @@ pub struct Track {
     ph: Vec<f64>,
     zs_prev: Vec<f64>,
     ph_prev: Vec<f64>,
-    pad_left: Vec<f64>,
-    pad_right: Vec<f64>,
-    /// Scratch: rail deflections at the sleeper nodes (left, right, left at t_(j-1), right at t_(j-1)).
-    gather: Vec<f64>,
-    simd: bool,
+    /// Pad forces on the rails (N), left rail sleepers then right rail sleepers.
+    pad: Vec<f64>,
+    simd: SimdLevel,
 }
 
-/// Borrowed views for the sleeper update.
-struct SleeperSlices<'a> {
-    rl: &'a [f64],
-    rr: &'a [f64],
-    rlp: &'a [f64],
-    rrp: &'a [f64],
-    zs: &'a [f64],
-    ph: &'a [f64],
-    zsp: &'a mut [f64],
-    php: &'a mut [f64],
-    pl: &'a mut [f64],
-    pr: &'a mut [f64],
-}
-
-/// Pad forces (3.9) and sleeper update (3.18) for every sleeper.
+/// Pad forces (3.9) and sleeper update (3.18) for every sleeper: rail deflections
+/// above the sleepers at t_j (`rl`, `rr`) and t_(j-1) (`rlp`, `rrp`), sleeper bounce
+/// and roll at t_j (`zs`, `ph`) and t_(j-1) (`zsp`, `php`, overwritten with t_(j+1)),
+/// pad forces out (`pl`, `pr`). Separate slice arguments (not a struct of slices) so
+/// that the compiler knows they do not alias and vectorises without runtime checks.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sleepers_body(s: SleeperSlices<'_>, c: &Coeffs, ls: f64) {
-    let ns = s.zs.len();
-    let (rl, rr, rlp, rrp) = (&s.rl[..ns], &s.rr[..ns], &s.rlp[..ns], &s.rrp[..ns]);
-    let (zs, ph) = (&s.zs[..ns], &s.ph[..ns]);
-    let (zsp, php) = (&mut s.zsp[..ns], &mut s.php[..ns]);
-    let (pl, pr) = (&mut s.pl[..ns], &mut s.pr[..ns]);
+fn sleepers_body(
+    rl: &[f64],
+    rr: &[f64],
+    rlp: &[f64],
+    rrp: &[f64],
+    zs: &[f64],
+    ph: &[f64],
+    zsp: &mut [f64],
+    php: &mut [f64],
+    pl: &mut [f64],
+    pr: &mut [f64],
+    c: &Coeffs,
+    ls: f64,
+) {
+    let ns = zs.len();
+    let (rl, rr, rlp, rrp) = (&rl[..ns], &rr[..ns], &rlp[..ns], &rrp[..ns]);
+    let (ph, zsp, php) = (&ph[..ns], &mut zsp[..ns], &mut php[..ns]);
+    let (pl, pr) = (&mut pl[..ns], &mut pr[..ns]);
     for i in 0..ns {
         let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
         let seat_l = z - ls * f;
@@ -361,73 +412,77 @@ fn sleepers_body(s: SleeperSlices<'_>, c: &Coeffs, ls: f64) {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn sleepers_avx2(s: SleeperSlices<'_>, c: &Coeffs, ls: f64) {
-    sleepers_body(s, c, ls)
-}
-
-#[inline]
-fn sleepers(s: SleeperSlices<'_>, c: &Coeffs, ls: f64, simd: bool) {
-    #[cfg(target_arch = "x86_64")]
-    if simd {
-        // SAFETY: `simd` is only true when the CPU reports AVX2.
-        unsafe { sleepers_avx2(s, c, ls) };
-        return;
-    }
-    let _ = simd;
-    sleepers_body(s, c, ls)
-}
-
-/// Rail stencil over both rails stored end to end: new values are written over the
-/// t_(j-1) arrays. The end nodes are left to the caller.
+/// One phase block of the rail stencil (3.12): centre nodes `zc`, `tc` with their
+/// left (`zl`, `tl`) and right (`zr`, `tr`) neighbours, new values written over the
+/// t_(j-1) values `zn`, `tn`. With `PAD` the block holds the sleeper nodes and the pad
+/// forces `pad` enter.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn stencil_body(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs) {
-    let len = z.len();
-    let m = len - 2;
-    let (zl, zc, zr) = (&z[..m], &z[1..m + 1], &z[2..m + 2]);
-    let (tl, tc, tr) = (&th[..m], &th[1..m + 1], &th[2..m + 2]);
-    let zn = &mut z_prev[1..m + 1];
-    let tn = &mut th_prev[1..m + 1];
+fn stencil_body<const PAD: bool>(
+    zl: &[f64],
+    zc: &[f64],
+    zr: &[f64],
+    tl: &[f64],
+    tc: &[f64],
+    tr: &[f64],
+    zn: &mut [f64],
+    tn: &mut [f64],
+    pad: &[f64],
+    c: &Coeffs,
+) {
+    let m = zc.len();
+    let (zl, zr) = (&zl[..m], &zr[..m]);
+    let (tl, tc, tr) = (&tl[..m], &tc[..m], &tr[..m]);
+    let (zn, tn) = (&mut zn[..m], &mut tn[..m]);
+    let pad = if PAD { &pad[..m] } else { &pad[..0] };
     for i in 0..m {
         let zci = zc[i];
         let tci = tc[i];
-        zn[i] = 2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
+        let znew = 2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
+        zn[i] = if PAD { znew + c.force * pad[i] } else { znew };
         tn[i] = 2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i]) + c.tz * (zr[i] - zl[i])
             - c.t0 * tci;
     }
 }
 
-/// The same stencil compiled for AVX2 (4 lanes). No FMA is used, so both versions
-/// give bit-identical results.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn stencil_avx2(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs) {
-    stencil_body(z, th, z_prev, th_prev, c)
+/// Compiles a loop body for each [`Simd`] level and dispatches on the level.
+macro_rules! simd_kernel {
+    ($name:ident, $body:path, ($($arg:ident : $ty:ty),*)) => {
+        #[allow(clippy::too_many_arguments)]
+        #[inline]
+        fn $name(simd: SimdLevel, $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[allow(clippy::too_many_arguments)]
+                #[target_feature(enable = "avx2")]
+                fn avx2($($arg: $ty),*) {
+                    $body($($arg),*)
+                }
+                match simd {
+                    // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
+                    // `Track::set_simd`).
+                    SimdLevel::Avx2 => return unsafe { avx2($($arg),*) },
+                    SimdLevel::Baseline => {}
+                }
+            }
+            let _ = simd;
+            $body($($arg),*)
+        }
+    };
 }
 
-#[inline]
-fn stencil(z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], c: &Coeffs, simd: bool) {
-    #[cfg(target_arch = "x86_64")]
-    if simd {
-        // SAFETY: `simd` is only true when the CPU reports AVX2 (checked in `new_unchecked`).
-        unsafe { stencil_avx2(z, th, z_prev, th_prev, c) };
-        return;
-    }
-    let _ = simd;
-    stencil_body(z, th, z_prev, th_prev, c)
-}
-
-fn cpu_has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
+simd_kernel!(sleepers, sleepers_body, (
+    rl: &[f64], rr: &[f64], rlp: &[f64], rrp: &[f64], zs: &[f64], ph: &[f64],
+    zsp: &mut [f64], php: &mut [f64], pl: &mut [f64], pr: &mut [f64], c: &Coeffs, ls: f64
+));
+simd_kernel!(stencil_pad, stencil_body::<true>, (
+    zl: &[f64], zc: &[f64], zr: &[f64], tl: &[f64], tc: &[f64], tr: &[f64],
+    zn: &mut [f64], tn: &mut [f64], pad: &[f64], c: &Coeffs
+));
+simd_kernel!(stencil_free, stencil_body::<false>, (
+    zl: &[f64], zc: &[f64], zr: &[f64], tl: &[f64], tc: &[f64], tr: &[f64],
+    zn: &mut [f64], tn: &mut [f64], pad: &[f64], c: &Coeffs
+));
 
 impl Track {
     /// A track at rest and undeformed, stepped with `dt` (s). Refuses a step above
@@ -450,27 +505,29 @@ impl Track {
 
     /// Builds the stepper without the stability check (validated parameters only).
     pub(crate) fn new_unchecked(params: TrackParams, dt: f64) -> Self {
-        let nk = params.spans * params.nodes_per_span + 1;
+        let n = params.nodes_per_span;
+        let nk = params.spans * n + 1;
         let ns = params.spans + 1;
         let c = Coeffs::new(&params, dt);
+        let len = n * 2 * ns;
         Track {
             params,
             dt,
             dt_critical: f64::NAN,
             nk,
+            ns,
             c,
-            z: vec![0.0; 2 * nk],
-            th: vec![0.0; 2 * nk],
-            z_prev: vec![0.0; 2 * nk],
-            th_prev: vec![0.0; 2 * nk],
+            slot: (0..nk).map(|k| (k % n) * 2 * ns + k / n).collect(),
+            z: vec![0.0; len],
+            th: vec![0.0; len],
+            z_prev: vec![0.0; len],
+            th_prev: vec![0.0; len],
             zs: vec![0.0; ns],
             ph: vec![0.0; ns],
             zs_prev: vec![0.0; ns],
             ph_prev: vec![0.0; ns],
-            pad_left: vec![0.0; ns],
-            pad_right: vec![0.0; ns],
-            gather: vec![0.0; 4 * ns],
-            simd: cpu_has_avx2(),
+            pad: vec![0.0; 2 * ns],
+            simd: SimdLevel::detect(),
         }
     }
 
@@ -490,13 +547,60 @@ impl Track {
     pub fn nodes(&self) -> usize {
         self.nk
     }
-    /// Rail deflections (m) of rail 0 (left) or 1 (right), nodes 0..=K.
-    pub fn rail_z(&self, rail: usize) -> &[f64] {
-        &self.z[rail * self.nk..(rail + 1) * self.nk]
+    /// Vector instructions the stepper uses.
+    pub fn simd(&self) -> SimdLevel {
+        self.simd
     }
-    /// Rail rotations (rad) of one rail.
-    pub fn rail_theta(&self, rail: usize) -> &[f64] {
-        &self.th[rail * self.nk..(rail + 1) * self.nk]
+    /// Makes the stepper use `level`; refused when this CPU lacks it.
+    pub fn set_simd(&mut self, level: SimdLevel) -> Result<()> {
+        if level > SimdLevel::detect() {
+            return Err(Error::Unsupported(format!(
+                "track.simd = {level:?}: this CPU supports up to {:?}",
+                SimdLevel::detect()
+            )));
+        }
+        self.simd = level;
+        Ok(())
+    }
+
+    /// Storage slot of node `k` (0..=K) of `rail` (0 left, 1 right).
+    #[inline]
+    fn slot_of(&self, rail: usize, k: usize) -> usize {
+        self.slot[k] + rail.min(1) * self.ns
+    }
+
+    /// Phase-blocked array `a` in node order, both rails end to end.
+    fn to_nodes(&self, a: &[f64]) -> Vec<f64> {
+        (0..2)
+            .flat_map(|r| (0..self.nk).map(move |k| a[self.slot_of(r, k)]))
+            .collect()
+    }
+
+    /// Writes node-order values `v` (both rails end to end) into phase-blocked `a`.
+    fn from_nodes(slot: &[usize], ns: usize, v: &[f64], a: &mut [f64]) {
+        let nk = slot.len();
+        for r in 0..2 {
+            for (k, &s) in slot.iter().enumerate() {
+                a[s + r * ns] = v[r * nk + k];
+            }
+        }
+    }
+
+    /// Rail deflections (m) of rail 0 (left) or 1 (right), nodes 0..=K.
+    pub fn rail_z(&self, rail: usize) -> Vec<f64> {
+        (0..self.nk)
+            .map(|k| self.z[self.slot_of(rail, k)])
+            .collect()
+    }
+    /// Rail rotations (rad) of one rail, nodes 0..=K.
+    pub fn rail_theta(&self, rail: usize) -> Vec<f64> {
+        (0..self.nk)
+            .map(|k| self.th[self.slot_of(rail, k)])
+            .collect()
+    }
+    /// Rail deflection (m) of node `k` (0..=K) of `rail`.
+    pub fn rail_z_node(&self, rail: usize, k: usize) -> f64 {
+        self.z[self.slot_of(rail, k)]
     }
     /// Sleeper bounce displacements (m).
     pub fn sleeper_z(&self) -> &[f64] {
@@ -508,17 +612,13 @@ impl Track {
     }
     /// Pad forces on the rails (N, up on the rail) at the last step, per sleeper.
     pub fn pad_forces(&self, rail: usize) -> &[f64] {
-        if rail == 0 {
-            &self.pad_left
-        } else {
-            &self.pad_right
-        }
+        let r = rail.min(1);
+        &self.pad[r * self.ns..(r + 1) * self.ns]
     }
 
-    /// The state arrays in the order of [`Track::state_vector`]: rails and sleepers at
-    /// t_j and t_(j-1), then the pad forces.
-    fn state_arrays_mut(&mut self) -> [&mut Vec<f64>; 10] {
-        [
+    /// Sets every displacement (at t_j and t_(j-1)) and pad force to zero.
+    pub fn reset(&mut self) {
+        for v in [
             &mut self.z,
             &mut self.th,
             &mut self.z_prev,
@@ -527,14 +627,8 @@ impl Track {
             &mut self.ph,
             &mut self.zs_prev,
             &mut self.ph_prev,
-            &mut self.pad_left,
-            &mut self.pad_right,
-        ]
-    }
-
-    /// Sets every displacement (at t_j and t_(j-1)) to zero.
-    pub fn reset(&mut self) {
-        for v in self.state_arrays_mut() {
+            &mut self.pad,
+        ] {
             v.iter_mut().for_each(|x| *x = 0.0);
         }
     }
@@ -554,105 +648,100 @@ impl Track {
     #[inline]
     pub fn rail_z_at(&self, rail: usize, x: f64) -> f64 {
         let (k, w) = self.locate(x);
-        let z = self.rail_z(rail);
-        (1.0 - w) * z[k] + w * z[k + 1]
+        (1.0 - w) * self.z[self.slot_of(rail, k)] + w * self.z[self.slot_of(rail, k + 1)]
     }
 
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
     pub fn step(&mut self, loads: &[PointLoad]) {
         let c = self.c;
-        let nk = self.nk;
+        let ns = self.ns;
+        let b = 2 * ns;
         let n = self.params.nodes_per_span;
         let ls = 0.5 * self.params.rail_seat_distance;
         // 1. Pad forces at t_j (backward-difference damper velocities) and the sleeper
-        //    update (3.18), in place over the t_(j-1) sleeper arrays. Rail values at the
-        //    sleeper nodes are gathered first so that the sleeper loop vectorises.
+        //    update (3.18), in place over the t_(j-1) sleeper arrays. Block 0 holds the
+        //    rail nodes above the sleepers.
         {
-            let ns = self.zs.len();
-            let g = &mut self.gather;
-            let (rl, rest) = g.split_at_mut(ns);
-            let (rr, rest) = rest.split_at_mut(ns);
-            let (rlp, rrp) = rest.split_at_mut(ns);
-            let (zl, zr) = self.z.split_at(nk);
-            let (zlp, zrp) = self.z_prev.split_at(nk);
-            for (i, (((a, b), cc), d)) in rl
-                .iter_mut()
-                .zip(rr.iter_mut())
-                .zip(rlp.iter_mut())
-                .zip(rrp.iter_mut())
-                .enumerate()
-            {
-                let k = i * n;
-                *a = zl[k];
-                *b = zr[k];
-                *cc = zlp[k];
-                *d = zrp[k];
-            }
-            let sl = SleeperSlices {
+            let (rl, rr) = self.z[..b].split_at(ns);
+            let (rlp, rrp) = self.z_prev[..b].split_at(ns);
+            let (pl, pr) = self.pad.split_at_mut(ns);
+            sleepers(
+                self.simd,
                 rl,
                 rr,
                 rlp,
                 rrp,
-                zs: &self.zs,
-                ph: &self.ph,
-                zsp: &mut self.zs_prev,
-                php: &mut self.ph_prev,
-                pl: &mut self.pad_left,
-                pr: &mut self.pad_right,
-            };
-            sleepers(sl, &c, ls, self.simd);
+                &self.zs,
+                &self.ph,
+                &mut self.zs_prev,
+                &mut self.ph_prev,
+                pl,
+                pr,
+                &c,
+                ls,
+            );
         }
-        // 2. Rail stencil, written in place over the t_(j-1) arrays.
-        let th_prev_ends = [
-            self.th_prev[0],
-            self.th_prev[nk - 1],
-            self.th_prev[nk],
-            self.th_prev[2 * nk - 1],
-        ];
-        stencil(
-            &self.z,
-            &self.th,
-            &mut self.z_prev,
-            &mut self.th_prev,
-            &c,
-            self.simd,
-        );
-        // 3. Pad and wheel forces on the new rail state; end conditions.
-        {
-            let ns = self.zs.len();
-            let (pl, pr) = (&self.pad_left[..ns], &self.pad_right[..ns]);
-            let (zl, zr) = self.z_prev.split_at_mut(nk);
-            for i in 0..ns {
-                let k = i * n;
-                zl[k] += c.force * pl[i];
-                zr[k] += c.force * pr[i];
-            }
+        // 2. Rail stencil block by block, written in place over the t_(j-1) arrays;
+        //    the pad forces enter block 0. Block p's left neighbours are block p - 1
+        //    (block n - 1 one slot back for p = 0), its right neighbours block p + 1
+        //    (block 0 one slot on for p = n - 1). Block 0's first and last slots are
+        //    rail ends, set below.
+        let ends = [0, ns - 1, ns, b - 1];
+        let th_prev_ends = ends.map(|e| self.th_prev[e]);
+        for p in 0..n {
+            let (j0, j1) = if p == 0 { (1, b - 1) } else { (0, b - 1) };
+            let (lo, lo_shift) = if p == 0 { (n - 1, 1) } else { (p - 1, 0) };
+            let (hi, hi_shift) = if p + 1 == n { (0, 1) } else { (p + 1, 0) };
+            let left = lo * b + j0 - lo_shift..lo * b + j1 - lo_shift;
+            let right = hi * b + j0 + hi_shift..hi * b + j1 + hi_shift;
+            let centre = p * b + j0..p * b + j1;
+            let kernel = if p == 0 { stencil_pad } else { stencil_free };
+            kernel(
+                self.simd,
+                &self.z[left.clone()],
+                &self.z[centre.clone()],
+                &self.z[right.clone()],
+                &self.th[left],
+                &self.th[centre.clone()],
+                &self.th[right],
+                &mut self.z_prev[centre.clone()],
+                &mut self.th_prev[centre],
+                &self.pad[j0..j1],
+                &c,
+            );
         }
+        // 3. Wheel forces on the new rail state; end conditions; unused slots.
         for l in loads {
             let (k, w) = self.locate(l.position);
-            let base = l.rail.min(1) * nk;
-            self.z_prev[base + k] -= c.force * (1.0 - w) * l.force;
-            self.z_prev[base + k + 1] -= c.force * w * l.force;
+            let (s0, s1) = (self.slot_of(l.rail, k), self.slot_of(l.rail, k + 1));
+            self.z_prev[s0] -= c.force * (1.0 - w) * l.force;
+            self.z_prev[s1] -= c.force * w * l.force;
         }
-        for end in [0, nk - 1, nk, 2 * nk - 1] {
-            self.z_prev[end] = 0.0;
+        for e in ends {
+            self.z_prev[e] = 0.0;
+        }
+        for p in 1..n {
+            for s in [p * b + ns - 1, p * b + b - 1] {
+                self.z_prev[s] = 0.0;
+                self.th_prev[s] = 0.0;
+            }
         }
         match self.params.ends {
             RailEnds::Fixed => {
-                for end in [0, nk - 1, nk, 2 * nk - 1] {
-                    self.th_prev[end] = 0.0;
+                for e in ends {
+                    self.th_prev[e] = 0.0;
                 }
             }
             RailEnds::Pinned => {
                 // Ghost nodes: Z odd, theta even about the support.
-                let ends = [
-                    (0, 1),
-                    (nk - 1, nk - 2),
-                    (nk, nk + 1),
-                    (2 * nk - 1, 2 * nk - 2),
-                ];
-                for (e, (end, inner)) in ends.into_iter().enumerate() {
-                    let sgn = if inner > end { 1.0 } else { -1.0 };
+                let nk = self.nk;
+                let pairs = [(0, 1), (nk - 1, nk - 2)];
+                for (e, end) in ends.into_iter().enumerate() {
+                    let rail = e / 2;
+                    let (node, inner) = pairs[e % 2];
+                    debug_assert_eq!(end, self.slot_of(rail, node));
+                    let inner = self.slot_of(rail, inner);
+                    let sgn = if e % 2 == 0 { 1.0 } else { -1.0 };
                     let (t0, ti, zi) = (self.th[end], self.th[inner], self.z[inner]);
                     self.th_prev[end] = 2.0 * t0 - th_prev_ends[e]
                         + c.tt * (2.0 * ti - 2.0 * t0)
@@ -776,22 +865,21 @@ impl Track {
                 .into(),
             time: 0.0,
         })?;
-        self.z.copy_from_slice(&x.as_slice()[..2 * nk]);
-        self.th.copy_from_slice(&x.as_slice()[2 * nk..4 * nk]);
-        self.zs.copy_from_slice(&x.as_slice()[4 * nk..4 * nk + ns]);
-        self.ph.copy_from_slice(&x.as_slice()[4 * nk + ns..]);
+        let xs = x.as_slice();
+        Self::from_nodes(&self.slot, ns, &xs[..2 * nk], &mut self.z);
+        Self::from_nodes(&self.slot, ns, &xs[2 * nk..4 * nk], &mut self.th);
+        self.zs.copy_from_slice(&xs[4 * nk..4 * nk + ns]);
+        self.ph.copy_from_slice(&xs[4 * nk + ns..]);
         self.z_prev.copy_from_slice(&self.z);
         self.th_prev.copy_from_slice(&self.th);
         self.zs_prev.copy_from_slice(&self.zs);
         self.ph_prev.copy_from_slice(&self.ph);
+        let ls = 0.5 * self.params.rail_seat_distance;
         for i in 0..ns {
-            let kn = i * self.params.nodes_per_span;
-            self.pad_left[i] = -self.params.pad_stiffness
-                * (self.z[kn] - self.zs[i] + 0.5 * self.params.rail_seat_distance * self.ph[i]);
-            self.pad_right[i] = -self.params.pad_stiffness
-                * (self.z[nk + kn]
-                    - self.zs[i]
-                    - 0.5 * self.params.rail_seat_distance * self.ph[i]);
+            // Block 0 holds the rail nodes above the sleepers.
+            self.pad[i] = -self.params.pad_stiffness * (self.z[i] - self.zs[i] + ls * self.ph[i]);
+            self.pad[ns + i] =
+                -self.params.pad_stiffness * (self.z[ns + i] - self.zs[i] - ls * self.ph[i]);
         }
         Ok(())
     }
@@ -808,13 +896,15 @@ impl Track {
         let mut x = DVector::<f64>::zeros(n);
         let mut xp = DVector::<f64>::zeros(n);
         let mut mass = DVector::<f64>::zeros(n);
+        let (z, zp) = (self.to_nodes(&self.z), self.to_nodes(&self.z_prev));
+        let (th, thp) = (self.to_nodes(&self.th), self.to_nodes(&self.th_prev));
         for i in 0..2 * nk {
             let end = i % nk == 0 || i % nk == nk - 1;
-            x[i] = self.z[i];
-            xp[i] = self.z_prev[i];
+            x[i] = z[i];
+            xp[i] = zp[i];
             mass[i] = p.rail.mass * dx;
-            x[2 * nk + i] = self.th[i];
-            xp[2 * nk + i] = self.th_prev[i];
+            x[2 * nk + i] = th[i];
+            xp[2 * nk + i] = thp[i];
             mass[2 * nk + i] = p.rail.rotary_inertia * if end { 0.5 * dx } else { dx };
         }
         for i in 0..ns {
@@ -834,10 +924,11 @@ impl Track {
     /// Sets the state at t_j and t_(j-1) directly (for tests and restarts): rail
     /// deflection and rotation of both rails end to end, then sleepers.
     pub fn set_state(&mut self, z: &[f64], th: &[f64], z_prev: &[f64], th_prev: &[f64]) {
-        self.z.copy_from_slice(z);
-        self.th.copy_from_slice(th);
-        self.z_prev.copy_from_slice(z_prev);
-        self.th_prev.copy_from_slice(th_prev);
+        let (slot, ns) = (&self.slot, self.ns);
+        Self::from_nodes(slot, ns, z, &mut self.z);
+        Self::from_nodes(slot, ns, th, &mut self.th);
+        Self::from_nodes(slot, ns, z_prev, &mut self.z_prev);
+        Self::from_nodes(slot, ns, th_prev, &mut self.th_prev);
     }
 
     /// Changes the time step to `dt` (s), keeping the displacements at t_j and the
@@ -874,24 +965,16 @@ impl Track {
         1 + 8 * self.nk + 6 * self.zs.len()
     }
 
-    /// Everything that determines the continuation: the step, rails and sleepers at
-    /// t_j and t_(j-1), and the last pad forces. [`Track::set_state_vector`] restores
-    /// it exactly.
+    /// Everything that determines the continuation: the step, rails (node order, both
+    /// rails end to end) and sleepers at t_j and t_(j-1), and the last pad forces.
+    /// [`Track::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = Vec::with_capacity(self.state_len());
         v.push(self.dt);
-        for a in [
-            &self.z,
-            &self.th,
-            &self.z_prev,
-            &self.th_prev,
-            &self.zs,
-            &self.ph,
-            &self.zs_prev,
-            &self.ph_prev,
-            &self.pad_left,
-            &self.pad_right,
-        ] {
+        for a in [&self.z, &self.th, &self.z_prev, &self.th_prev] {
+            v.extend(self.to_nodes(a));
+        }
+        for a in [&self.zs, &self.ph, &self.zs_prev, &self.ph_prev, &self.pad] {
             v.extend_from_slice(a);
         }
         v
@@ -910,8 +993,25 @@ impl Track {
         if v[0] != self.dt {
             self.change_dt(v[0])?;
         }
+        let (nr, ns) = (2 * self.nk, self.ns);
         let mut rest = &v[1..];
-        for a in self.state_arrays_mut() {
+        for a in [
+            &mut self.z,
+            &mut self.th,
+            &mut self.z_prev,
+            &mut self.th_prev,
+        ] {
+            let (head, tail) = rest.split_at(nr);
+            Self::from_nodes(&self.slot, ns, head, a);
+            rest = tail;
+        }
+        for a in [
+            &mut self.zs,
+            &mut self.ph,
+            &mut self.zs_prev,
+            &mut self.ph_prev,
+            &mut self.pad,
+        ] {
             let (head, tail) = rest.split_at(a.len());
             a.copy_from_slice(head);
             rest = tail;
@@ -961,6 +1061,111 @@ mod tests {
             }
         }
         (ups[ups.len() - 1] - ups[0]) / (ups.len() - 1) as f64
+    }
+
+    #[test]
+    fn simd_levels_and_storage_agree_bit_for_bit() {
+        // Every SIMD level this CPU has gives the same bits, and the phase-blocked
+        // storage gives the same bits as the plain node-order recurrence written out
+        // here (the scheme of the module docs, one node at a time).
+        for n in [1usize, 2, 3] {
+            let p = seed_track(6, n);
+            let dt = 0.9 * p.critical_time_step().0;
+            let loads = [
+                PointLoad {
+                    rail: 0,
+                    position: 2.3,
+                    force: 1.1e5,
+                },
+                PointLoad {
+                    rail: 1,
+                    position: 2.3,
+                    force: 0.7e5,
+                },
+            ];
+            let mut runs = Vec::new();
+            for level in SimdLevel::available() {
+                let mut t = Track::new(p, dt).unwrap();
+                t.set_simd(level).unwrap();
+                for _ in 0..3000 {
+                    t.step(&loads);
+                }
+                runs.push(t.state_vector());
+            }
+            for r in &runs[1..] {
+                assert!(
+                    r.iter()
+                        .zip(&runs[0])
+                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                );
+            }
+            // Node-order reference.
+            let t = Track::new(p, dt).unwrap();
+            let c = t.c;
+            let nk = t.nodes();
+            let ns = p.spans + 1;
+            let ls = 0.5 * p.rail_seat_distance;
+            let (mut z, mut th) = (vec![0.0; 2 * nk], vec![0.0; 2 * nk]);
+            let (mut zp, mut thp) = (z.clone(), th.clone());
+            let (mut zs, mut ph) = (vec![0.0; ns], vec![0.0; ns]);
+            let (mut zsp, mut php) = (zs.clone(), ph.clone());
+            let mut pad = vec![0.0; 2 * ns];
+            for _ in 0..3000 {
+                for i in 0..ns {
+                    let (zz, f, zq, fq) = (zs[i], ph[i], zsp[i], php[i]);
+                    let mut fl = [0.0; 2];
+                    for (r, sg) in [(0usize, -1.0), (1, 1.0)] {
+                        let k = r * nk + i * n;
+                        let seat = zz + sg * ls * f;
+                        let dseat = seat - (zq + sg * ls * fq);
+                        fl[r] = -c.kp * (z[k] - seat) - c.cp_dt * ((z[k] - zp[k]) - dseat);
+                        pad[r * ns + i] = fl[r];
+                    }
+                    zsp[i] = (c.zs_a * zz + c.zs_b * zq - c.zs_f * (fl[0] + fl[1])) * c.zs_den;
+                    php[i] = (c.ph_a * f + c.ph_b * fq + c.ph_f * (fl[0] - fl[1])) * c.ph_den;
+                }
+                for g in 1..2 * nk - 1 {
+                    let (zc, tc) = (z[g], th[g]);
+                    zp[g] = 2.0 * zc - zp[g] + c.zz * (z[g + 1] - 2.0 * zc + z[g - 1])
+                        - c.zt * (th[g + 1] - th[g - 1]);
+                    thp[g] = 2.0 * tc - thp[g]
+                        + c.tt * (th[g + 1] - 2.0 * tc + th[g - 1])
+                        + c.tz * (z[g + 1] - z[g - 1])
+                        - c.t0 * tc;
+                }
+                for r in 0..2 {
+                    for i in 0..ns {
+                        zp[r * nk + i * n] += c.force * pad[r * ns + i];
+                    }
+                }
+                for l in &loads {
+                    let (k, w) = t.locate(l.position);
+                    zp[l.rail * nk + k] -= c.force * (1.0 - w) * l.force;
+                    zp[l.rail * nk + k + 1] -= c.force * w * l.force;
+                }
+                for e in [0, nk - 1, nk, 2 * nk - 1] {
+                    zp[e] = 0.0;
+                    thp[e] = 0.0;
+                }
+                std::mem::swap(&mut z, &mut zp);
+                std::mem::swap(&mut th, &mut thp);
+                std::mem::swap(&mut zs, &mut zsp);
+                std::mem::swap(&mut ph, &mut php);
+            }
+            let mut want = vec![dt];
+            for a in [&z, &th, &zp, &thp, &zs, &ph, &zsp, &php, &pad] {
+                want.extend_from_slice(a);
+            }
+            assert_eq!(want.len(), runs[0].len());
+            let same = want
+                .iter()
+                .zip(&runs[0])
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+            assert!(
+                same,
+                "n = {n}: phase-blocked storage differs from node order"
+            );
+        }
     }
 
     #[test]
@@ -1057,8 +1262,8 @@ mod tests {
         let zd = dynm.rail_z_at(0, x);
         assert!(((zs - zd) / zs).abs() < 1e-6, "{zs} vs {zd}");
         let thmax = stat.th.iter().fold(0.0f64, |m, t| m.max(t.abs()));
-        let dz = (0..2 * stat.nk).fold(0.0f64, |m, i| m.max((stat.z[i] - dynm.z[i]).abs()));
-        let dth = (0..2 * stat.nk).fold(0.0f64, |m, i| m.max((stat.th[i] - dynm.th[i]).abs()));
+        let dz = (0..stat.z.len()).fold(0.0f64, |m, i| m.max((stat.z[i] - dynm.z[i]).abs()));
+        let dth = (0..stat.z.len()).fold(0.0f64, |m, i| m.max((stat.th[i] - dynm.th[i]).abs()));
         assert!(
             dz < 1e-6 * zs.abs() && dth < 1e-6 * thmax,
             "{dz} {dth} {thmax}"
