@@ -25,6 +25,50 @@ pub fn wrap_angle(a: f64) -> f64 {
     r
 }
 
+/// `tan a`: the quotient of the sine and cosine Taylor polynomials for
+/// `|a| <= 0.2` rad (both exact to well under an ulp there), the library tangent
+/// otherwise.
+#[inline]
+pub fn tan_small(a: f64) -> f64 {
+    if a.abs() <= 0.2 {
+        let x = a * a;
+        let sin = a
+            * (1.0
+                + x * (-1.0 / 6.0
+                    + x * (1.0 / 120.0
+                        + x * (-1.0 / 5040.0 + x * (1.0 / 362880.0 - x / 39916800.0)))));
+        sin / crate::contact::cos_small(a)
+    } else {
+        a.tan()
+    }
+}
+
+/// `cos a` for `|a| <= pi/2` by its Taylor polynomial to `a^20` (first omitted term
+/// below 2e-17).
+#[inline]
+fn cos_half_pi(a: f64) -> f64 {
+    let x = a * a;
+    // Coefficients (-1)^k / (2k)!, k = 0..=10, by Horner's rule from the top.
+    const C: [f64; 11] = [
+        1.0,
+        -1.0 / 2.0,
+        1.0 / 24.0,
+        -1.0 / 720.0,
+        1.0 / 40320.0,
+        -1.0 / 3628800.0,
+        1.0 / 479001600.0,
+        -1.0 / 87178291200.0,
+        1.0 / 20922789888000.0,
+        -1.0 / 6402373705728000.0,
+        1.0 / 2432902008176640000.0,
+    ];
+    let mut r = C[10];
+    for c in C[..10].iter().rev() {
+        r = r * x + c;
+    }
+    r
+}
+
 /// Shape of a flat.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FlatShape {
@@ -98,12 +142,23 @@ impl Flat {
             FlatShape::Haversine => {
                 // (2.16); x is clamped to [0, l_f] so that the profile is
                 // continuous at the flat ends (the seed's x misses 0 by ~1e-5 l_f).
-                let x = (0.5 * self.length + (self.radius - self.depth) * psi.tan())
+                let x = (0.5 * self.length + (self.radius - self.depth) * tan_small(psi))
                     .clamp(0.0, self.length);
-                0.5 * self.depth * (1.0 - (2.0 * PI * x / self.length).cos())
+                // D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l), with
+                // sin(pi x / l) = cos(pi x / l - pi/2) and the argument in [-pi/2, pi/2].
+                let s = cos_half_pi(PI * x / self.length - 0.5 * PI);
+                self.depth * s * s
             }
-            FlatShape::Chord => self.radius - (self.radius - self.depth) / psi.cos(),
+            FlatShape::Chord => {
+                self.radius - (self.radius - self.depth) / crate::contact::cos_small(psi)
+            }
         }
+    }
+
+    /// Radius reduction (m) at space angle `alpha` (rad) for axle rotation `gamma` (rad).
+    #[inline]
+    pub fn reduction_at(&self, alpha: f64, gamma: f64) -> f64 {
+        self.reduction(wrap_angle(alpha + gamma - self.angle))
     }
 }
 
@@ -159,9 +214,25 @@ impl WheelProfile {
     pub fn reduction(&self, alpha: f64, gamma: f64) -> f64 {
         let mut f = 0.0f64;
         for fl in &self.flats {
-            f = f.max(fl.reduction(wrap_angle(alpha + gamma - fl.angle)));
+            f = f.max(fl.reduction_at(alpha, gamma));
         }
         f
+    }
+
+    /// Index of the flat whose reduction is largest (and positive) at space angle
+    /// `alpha` (rad) for axle rotation `gamma` (rad): the flat that shapes the wheel
+    /// there.
+    pub fn dominant_flat(&self, alpha: f64, gamma: f64) -> Option<usize> {
+        let mut best = None;
+        let mut f = 0.0f64;
+        for (i, fl) in self.flats.iter().enumerate() {
+            let r = fl.reduction_at(alpha, gamma);
+            if r > f {
+                f = r;
+                best = Some(i);
+            }
+        }
+        best
     }
 
     /// Instantaneous radius `R_i` (m) at space angle `alpha` for axle rotation `gamma` (2.18).
@@ -338,6 +409,22 @@ mod tests {
         .unwrap();
         assert!((w.reduction(0.02, 0.0) - 0.002).abs() < 1e-15);
         assert!((w.reduction(-0.05, 0.0) - w.flats()[0].reduction(-0.05)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn polynomial_trig_matches_library() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=20_000 {
+            let a = -0.25 + 0.5 * i as f64 / 20_000.0;
+            worst = worst.max(((tan_small(a) - a.tan()) / a.tan().abs().max(1e-300)).abs());
+        }
+        assert!(worst < 5e-16, "tan: {worst:e}");
+        let mut worst: f64 = 0.0;
+        for i in 0..=20_000 {
+            let a = -0.5 * PI + PI * i as f64 / 20_000.0;
+            worst = worst.max((cos_half_pi(a) - a.cos()).abs());
+        }
+        assert!(worst < 5e-16, "cos: {worst:e}");
     }
 
     #[test]

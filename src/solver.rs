@@ -265,8 +265,18 @@ impl Simulation {
     }
 
     /// Axle rotation angle wrapped into [0, 2 pi) (rad): what places the flats.
+    ///
+    /// The whole number of turns is taken off by truncation rather than `rem_euclid`
+    /// (a libm `fmod` call): the result differs by a rounding of the turns removed,
+    /// which is below the rounding already in the unwrapped angle.
     fn rotation_wrapped(&self) -> f64 {
-        self.rotation().rem_euclid(std::f64::consts::TAU)
+        use std::f64::consts::TAU;
+        let a = self.rotation();
+        if !a.is_finite() || a.abs() > 1e15 {
+            return a.rem_euclid(TAU);
+        }
+        let r = a - (a * (1.0 / TAU)) as i64 as f64 * TAU;
+        if r < 0.0 { r + TAU } else { r }
     }
     /// Static wheel loads (N).
     pub fn static_load(&self) -> [f64; 2] {
