@@ -250,8 +250,12 @@ pub struct PointLoad {
 #[derive(Debug, Clone, Copy)]
 struct Coeffs {
     zz: f64,
+    /// `2 - 2 zz`: centre weight of the deflection update.
+    zc: f64,
     zt: f64,
     tt: f64,
+    /// `2 - 2 tt - t0`: centre weight of the rotation update.
+    tc: f64,
     tz: f64,
     t0: f64,
     force: f64,
@@ -277,12 +281,17 @@ impl Coeffs {
         let ls = 0.5 * p.rail_seat_distance;
         let kphi = 2.0 * ls * ls * p.ballast_stiffness;
         let cphi = 2.0 * ls * ls * p.ballast_damping;
+        let zz = r.kag * dt2 / (r.mass * dx * dx);
+        let tt = r.ei * dt2 / (r.rotary_inertia * dx * dx);
+        let t0 = r.kag * dt2 / r.rotary_inertia;
         Coeffs {
-            zz: r.kag * dt2 / (r.mass * dx * dx),
+            zz,
+            zc: 2.0 - 2.0 * zz,
             zt: r.kag * dt2 / (2.0 * r.mass * dx),
-            tt: r.ei * dt2 / (r.rotary_inertia * dx * dx),
+            tt,
+            tc: 2.0 - 2.0 * tt - t0,
             tz: r.kag * dt2 / (2.0 * r.rotary_inertia * dx),
-            t0: r.kag * dt2 / r.rotary_inertia,
+            t0,
             force: dt2 / (r.mass * dx),
             kp: p.pad_stiffness,
             cp_dt: p.pad_damping / dt,
@@ -349,6 +358,8 @@ pub struct Track {
     params: TrackParams,
     dt: f64,
     dt_critical: f64,
+    /// Grid spacing `dx` (m).
+    dx: f64,
     /// Nodes per rail `K + 1`.
     nk: usize,
     /// Sleepers `N_s = N + 1`.
@@ -438,10 +449,11 @@ fn stencil_body<const PAD: bool>(
     for i in 0..m {
         let zci = zc[i];
         let tci = tc[i];
-        let znew = 2.0 * zci - zn[i] + c.zz * (zr[i] - 2.0 * zci + zl[i]) - c.zt * (tr[i] - tl[i]);
+        // (3.12) with the centre terms gathered: 8 operations per value instead of 10
+        // and 13.
+        let znew = c.zc * zci - zn[i] + c.zz * (zr[i] + zl[i]) - c.zt * (tr[i] - tl[i]);
         zn[i] = if PAD { znew + c.force * pad[i] } else { znew };
-        tn[i] = 2.0 * tci - tn[i] + c.tt * (tr[i] - 2.0 * tci + tl[i]) + c.tz * (zr[i] - zl[i])
-            - c.t0 * tci;
+        tn[i] = c.tc * tci - tn[i] + c.tt * (tr[i] + tl[i]) + c.tz * (zr[i] - zl[i]);
     }
 }
 
@@ -514,6 +526,7 @@ impl Track {
             params,
             dt,
             dt_critical: f64::NAN,
+            dx: params.dx(),
             nk,
             ns,
             c,
@@ -637,8 +650,7 @@ impl Track {
     /// `(1 - w)` to node `k` and `w` to node `k + 1` (3.22).
     #[inline]
     pub fn locate(&self, x: f64) -> (usize, f64) {
-        let dx = self.params.dx();
-        let s = (x / dx).max(0.0);
+        let s = (x / self.dx).max(0.0);
         // Truncation equals floor for s >= 0 and avoids a libm call.
         let k = (s as usize).min(self.nk - 2);
         (k, (s - k as f64).clamp(0.0, 1.0))
@@ -1126,12 +1138,11 @@ mod tests {
                 }
                 for g in 1..2 * nk - 1 {
                     let (zc, tc) = (z[g], th[g]);
-                    zp[g] = 2.0 * zc - zp[g] + c.zz * (z[g + 1] - 2.0 * zc + z[g - 1])
+                    zp[g] = c.zc * zc - zp[g] + c.zz * (z[g + 1] + z[g - 1])
                         - c.zt * (th[g + 1] - th[g - 1]);
-                    thp[g] = 2.0 * tc - thp[g]
-                        + c.tt * (th[g + 1] - 2.0 * tc + th[g - 1])
-                        + c.tz * (z[g + 1] - z[g - 1])
-                        - c.t0 * tc;
+                    thp[g] = c.tc * tc - thp[g]
+                        + c.tt * (th[g + 1] + th[g - 1])
+                        + c.tz * (z[g + 1] - z[g - 1]);
                 }
                 for r in 0..2 {
                     for i in 0..ns {
