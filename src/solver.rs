@@ -410,7 +410,11 @@ impl Simulation {
                 });
             }
         }
-        let s = self.sample();
+        // The cached sample, if the outputs were read at this instant, is used up here.
+        let s = match self.cached.take() {
+            Some(s) => s,
+            None => self.compute_sample(),
+        };
         let p = [s.contact[0].force, s.contact[1].force];
         if !(p[0].is_finite() && p[1].is_finite()) {
             return Err(Error::NonFinite {
@@ -431,7 +435,6 @@ impl Simulation {
             TrackState::Discrete(t) => t.step(&wheel_loads(x, p)),
             TrackState::Lumped(t) => t.step(p),
         }
-        self.cached.set(None);
         self.steps += 1;
         self.k += 1;
         Ok(s)
