@@ -12,7 +12,7 @@
 //! asymmetric and split patches are all exact to quadrature accuracy.
 
 use crate::error::{Result, out_of_range, positive};
-use crate::profile::{MAX_FLATS, WheelProfile, wrap_angle};
+use crate::profile::{MAX_FLATS, WheelProfile, cos_small, wrap_angle};
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.
@@ -115,22 +115,6 @@ pub fn sin_minus_x_cos(a: f64) -> f64 {
                 + a2 * (-1.0 / 30.0 + a2 * (1.0 / 840.0 + a2 * (-1.0 / 45360.0 + a2 / 3991680.0))))
     } else {
         a.sin() - a * a.cos()
-    }
-}
-
-/// `cos a`: its Taylor polynomial to `a^10` for `|a| <= 0.2` rad (the first omitted
-/// term is below 1e-17, under half an ulp of the result), the library cosine
-/// otherwise. Contact patches are a few hundredths of a radian wide, so the
-/// integrand of (2.8) takes the polynomial.
-#[inline]
-pub fn cos_small(a: f64) -> f64 {
-    if a.abs() <= 0.2 {
-        let x = a * a;
-        1.0 + x
-            * (-1.0 / 2.0
-                + x * (1.0 / 24.0 + x * (-1.0 / 720.0 + x * (1.0 / 40320.0 - x / 3628800.0))))
-    } else {
-        a.cos()
     }
 }
 

@@ -582,11 +582,14 @@ impl Track {
         self.slot[k] + rail.min(1) * self.ns
     }
 
+    /// Values of phase-blocked array `a` on `rail`, nodes 0..=K.
+    fn rail_nodes<'a>(&'a self, a: &'a [f64], rail: usize) -> impl Iterator<Item = f64> + 'a {
+        (0..self.nk).map(move |k| a[self.slot_of(rail, k)])
+    }
+
     /// Phase-blocked array `a` in node order, both rails end to end.
     fn to_nodes(&self, a: &[f64]) -> Vec<f64> {
-        (0..2)
-            .flat_map(|r| (0..self.nk).map(move |k| a[self.slot_of(r, k)]))
-            .collect()
+        self.rail_nodes(a, 0).chain(self.rail_nodes(a, 1)).collect()
     }
 
     /// Writes node-order values `v` (both rails end to end) into phase-blocked `a`.
@@ -601,19 +604,11 @@ impl Track {
 
     /// Rail deflections (m) of rail 0 (left) or 1 (right), nodes 0..=K.
     pub fn rail_z(&self, rail: usize) -> Vec<f64> {
-        (0..self.nk)
-            .map(|k| self.z[self.slot_of(rail, k)])
-            .collect()
+        self.rail_nodes(&self.z, rail).collect()
     }
     /// Rail rotations (rad) of one rail, nodes 0..=K.
     pub fn rail_theta(&self, rail: usize) -> Vec<f64> {
-        (0..self.nk)
-            .map(|k| self.th[self.slot_of(rail, k)])
-            .collect()
-    }
-    /// Rail deflection (m) of node `k` (0..=K) of `rail`.
-    pub fn rail_z_node(&self, rail: usize, k: usize) -> f64 {
-        self.z[self.slot_of(rail, k)]
+        self.rail_nodes(&self.th, rail).collect()
     }
     /// Sleeper bounce displacements (m).
     pub fn sleeper_z(&self) -> &[f64] {
