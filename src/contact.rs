@@ -397,9 +397,9 @@ fn adaptive(
                 continue;
             }
             let (lo, hi) = (xs[k.saturating_sub(1)], xs[(k + 1).min(nn - 1)]);
-            if let Some(xp) = positive_point(&g, lo, hi) {
-                roots[nr] = refine_root(&g, lo.max(xs[k].min(xp)), xp);
-                roots[nr + 1] = refine_root(&g, xp, hi);
+            if let Some((r0, r1)) = sliver(&g, lo, xs[k], hi) {
+                roots[nr] = r0;
+                roots[nr + 1] = r1;
                 nr += 2;
             }
         }
@@ -541,6 +541,15 @@ fn positive_point<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64) -> Option<f64> {
         }
     }
     None
+}
+
+/// Ends of a contact sliver of `g` around the sample `mid` (where `g <= 0`, as at `lo`
+/// and `hi`), or `None` when `g` stays non-positive on `[lo, hi]`. Each end is
+/// bracketed between the positive point found and the nearest non-positive sample.
+fn sliver<G: Fn(f64) -> f64>(g: &G, lo: f64, mid: f64, hi: f64) -> Option<(f64, f64)> {
+    let xp = positive_point(g, lo, hi)?;
+    let (left, right) = if xp > mid { (mid, hi) } else { (lo, mid) };
+    Some((refine_root(g, left, xp), refine_root(g, xp, right)))
 }
 
 fn gauss<G: Fn(f64) -> f64>(g: &G, a: f64, b: f64) -> f64 {
@@ -761,6 +770,14 @@ mod tests {
         assert!(peak(xp) > 0.0);
         let below = |x: f64| -1e-12 - (x - 0.3) * (x - 0.3);
         assert_eq!(positive_point(&below, 0.0, 1.0), None);
+        // Both ends of the sliver, with the peak left or right of the middle sample.
+        let half = 1e-6;
+        for mid in [0.2, 0.4] {
+            let (r0, r1) = sliver(&peak, 0.0, mid, 1.0).unwrap();
+            assert!((r0 - (0.3 - half)).abs() < 1e-9, "mid {mid}: {r0}");
+            assert!((r1 - (0.3 + half)).abs() < 1e-9, "mid {mid}: {r1}");
+        }
+        assert_eq!(sliver(&below, 0.0, 0.4, 1.0), None);
     }
 
     #[test]
