@@ -83,26 +83,63 @@ pub fn kw_from_hertz(ch: f64, static_load: f64, radius: f64) -> Result<f64> {
 /// `2 asin(sqrt(delta / (2 R_w)))` to keep precision at small overlap.
 #[inline]
 pub fn patch_angle(delta: f64, radius: f64) -> f64 {
-    let s = (0.5 * delta / radius).clamp(0.0, 1.0).sqrt();
-    2.0 * asin_small(s)
+    perfect_patch(delta, radius).0
 }
 
-/// `asin s` for `s >= 0`: its Taylor polynomial to `s^13` for `s <= 0.05` (overlaps
-/// up to about 2.4 mm on a 0.475 m wheel; the first omitted term is below 1e-19), the
-/// library arcsine otherwise.
+/// Perfect-wheel patch at overlap `delta` (m) on a wheel of radius `radius` (m):
+/// the patch angle `alpha_w` (rad), `sin alpha_w - alpha_w cos alpha_w` (the force
+/// (2.5) over `2 K_w R_w`) and `s^2 = sin^2(alpha_w / 2) = delta / (2 R_w)`.
+///
+/// For `s <= 0.05` (overlaps up to about 2.4 mm on a 0.475 m wheel) both are power
+/// series in `s^2` times a power of `s`: `alpha_w = 2 asin s = 2 s P(s^2)` and
+/// `sin alpha_w - alpha_w cos alpha_w = s^3 Q(s^2)` (the first omitted terms are below
+/// 1e-19 relative), so the square root and the polynomials run side by side and the
+/// cancellation of the difference never happens. Above, the library functions.
 #[inline]
-fn asin_small(s: f64) -> f64 {
-    if s <= 0.05 {
-        let x = s * s;
-        s * (1.0
-            + x * (1.0 / 6.0
-                + x * (3.0 / 40.0
-                    + x * (5.0 / 112.0
-                        + x * (35.0 / 1152.0 + x * (63.0 / 2816.0 + x * (231.0 / 13312.0)))))))
+fn perfect_patch(delta: f64, radius: f64) -> (f64, f64, f64) {
+    let x = (delta * (0.5 / radius)).clamp(0.0, 1.0);
+    if x <= 0.0025 {
+        let s = x.sqrt();
+        (
+            2.0 * s * estrin7(&ASIN_OVER_S, x),
+            s * x * estrin7(&SIN_MINUS_X_COS_OVER_S3, x),
+            x,
+        )
     } else {
-        s.asin()
+        let a = 2.0 * x.sqrt().asin();
+        (a, a.sin() - a * a.cos(), x)
     }
 }
+
+/// `c0 + c1 x + ... + c6 x^6` by Estrin's scheme.
+#[inline]
+fn estrin7(c: &[f64; 7], x: f64) -> f64 {
+    let x2 = x * x;
+    (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2 + ((c[4] + c[5] * x) + c[6] * x2) * (x2 * x2)
+}
+
+/// `asin(s) / s` in powers of `s^2`: `(2k)! / (4^k (k!)^2 (2k + 1))`.
+const ASIN_OVER_S: [f64; 7] = [
+    1.0,
+    1.0 / 6.0,
+    3.0 / 40.0,
+    5.0 / 112.0,
+    35.0 / 1152.0,
+    63.0 / 2816.0,
+    231.0 / 13312.0,
+];
+
+/// `(sin a - a cos a) / s^3` with `a = 2 asin s`, in powers of `s^2` (series of
+/// `2 s sqrt(1 - s^2) - 2 asin(s) (1 - 2 s^2)`, exact rationals).
+const SIN_MINUS_X_COS_OVER_S3: [f64; 7] = [
+    8.0 / 3.0,
+    4.0 / 15.0,
+    3.0 / 35.0,
+    5.0 / 126.0,
+    35.0 / 1584.0,
+    63.0 / 4576.0,
+    77.0 / 8320.0,
+];
 
 /// `sin a - a cos a`, by its series below 0.1 rad to avoid cancellation.
 #[inline]
@@ -135,7 +172,7 @@ pub fn perfect_wheel_force(kw: f64, radius: f64, delta: f64) -> f64 {
     if delta <= 0.0 {
         return 0.0;
     }
-    2.0 * kw * radius * sin_minus_x_cos(patch_angle(delta, radius))
+    2.0 * kw * radius * perfect_patch(delta, radius).1
 }
 
 /// Number of Gauss-Legendre points per contact interval.
@@ -275,33 +312,21 @@ fn adaptive(
         };
     }
     let delta = overlap.min(rw);
-    let aw = patch_angle(delta, rw);
-    let h = rw - delta;
-
-    // Flat windows (space angles) that reach into [-aw, aw] give the piece edges.
-    let mut edges = [0.0f64; 2 * MAX_FLATS + 2];
-    let mut ne = 0;
-    edges[ne] = -aw;
-    ne += 1;
-    let mut any = false;
-    for fl in wheel.flats() {
+    let (aw, sin_minus_x_cos_aw, s2) = perfect_patch(delta, rw);
+    // Flats whose window (space angles) reaches into [-aw, aw], with their centres.
+    let mut near = [(0.0f64, 0usize); MAX_FLATS];
+    let mut nf = 0;
+    for (i, fl) in wheel.flats().iter().enumerate() {
         let c = wrap_angle(fl.angle - gamma);
-        let (a, b) = (c - fl.half_angle, c + fl.half_angle);
-        if b > -aw && a < aw {
-            any = true;
-            for e in [a, b] {
-                if e > -aw && e < aw {
-                    edges[ne] = e;
-                    ne += 1;
-                }
-            }
+        if c + fl.half_angle > -aw && c - fl.half_angle < aw {
+            near[nf] = (c, i);
+            nf += 1;
         }
     }
-    if !any && !force_numeric {
+    if nf == 0 && !force_numeric {
         // sin(alpha_w) = 2 s sqrt(1 - s^2) with s = sin(alpha_w / 2) = sqrt(delta / 2 R_w).
-        let s2 = 0.5 * delta / rw;
         return ContactState {
-            force: 2.0 * kw * rw * sin_minus_x_cos(aw),
+            force: 2.0 * kw * rw * sin_minus_x_cos_aw,
             overlap,
             front_angle: aw,
             rear_angle: -aw,
@@ -309,22 +334,87 @@ fn adaptive(
             intervals: 1,
         };
     }
+    adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric)
+}
+
+/// The adaptive integral when flats reach into the patch `[-aw, aw]` (rad) at overlap
+/// `delta` (m) (or always, with `force_numeric`). `near`: those flats, as (centre
+/// space angle, index in the wheel's flats); their windows lie within `pi` of the
+/// patch, so a space angle `x` sits at `x - centre` from a flat's centre, unwrapped.
+#[inline(never)]
+fn adaptive_flats(
+    kw: f64,
+    wheel: &WheelProfile,
+    near: &[(f64, usize)],
+    overlap: f64,
+    delta: f64,
+    aw: f64,
+    force_numeric: bool,
+) -> ContactState {
+    let rw = wheel.radius;
+    let h = rw - delta;
+    let flats = wheel.flats();
+    let reduction_of = |j: usize, x: f64| {
+        let (c, i) = near[j];
+        flats[i].reduction(x - c)
+    };
+    let g = |x: f64| {
+        let mut f = 0.0f64;
+        for j in 0..near.len() {
+            f = f.max(reduction_of(j, x));
+        }
+        (rw - f) * cos_small(x) - h
+    };
+    let covered = |x: f64| {
+        near.iter()
+            .any(|&(c, i)| (x - c).abs() < flats[i].half_angle)
+    };
+    // Where overlapping flats hand over, the larger reduction wins: the flat that
+    // shapes the wheel at x (an index into `near`).
+    let several = near.len() > 1;
+    let dominant = |x: f64| {
+        if !several {
+            return None;
+        }
+        let (mut best, mut f) = (None, 0.0f64);
+        for j in 0..near.len() {
+            let r = reduction_of(j, x);
+            if r > f {
+                f = r;
+                best = Some(j);
+            }
+        }
+        best
+    };
+    // |g''| <= R_w + 2 max(|f'| + |f''|) (the flats' `bend_bound`): between samples d
+    // apart g rises at most `rise d^2` above the larger end value (plus rounding).
+    let bend = near
+        .iter()
+        .map(|&(_, i)| flats[i].bend_bound())
+        .fold(0.0, f64::max);
+    let rise = (rw + 2.0 * bend) / 8.0;
+
+    // Piece edges: the patch ends and the flat window edges inside the patch.
+    let mut edges = [0.0f64; 2 * MAX_FLATS + 2];
+    let mut ne = 0;
+    edges[ne] = -aw;
+    ne += 1;
+    for &(c, i) in near {
+        let ha = flats[i].half_angle;
+        for e in [c - ha, c + ha] {
+            if e > -aw && e < aw {
+                edges[ne] = e;
+                ne += 1;
+            }
+        }
+    }
     edges[ne] = aw;
     ne += 1;
     edges[..ne].sort_unstable_by(|a, b| a.total_cmp(b));
 
-    let g = |a: f64| wheel.radius_at(a, gamma) * cos_small(a) - h;
-    let several = wheel.flats().len() > 1;
-    let covered = |x: f64| {
-        wheel
-            .flats()
-            .iter()
-            .any(|fl| wrap_angle(x + gamma - fl.angle).abs() < fl.half_angle)
-    };
-
     // Break points: piece edges, every sign change of g inside flat-covered pieces,
-    // and where overlapping flats hand over (the larger reduction wins, so the
-    // integrand has a kink there that quadrature must not straddle).
+    // the ends of contact slivers between samples, and where overlapping flats hand
+    // over (a kink that quadrature must not straddle).
     let mut brk = [0.0f64; MAX_BREAKS];
     let mut nb = 0;
     for p in 0..ne - 1 {
@@ -343,15 +433,8 @@ fn adaptive(
         xs[0] = a;
         gs[0] = g(a);
         let mut nn = 1;
-        let mut roots = [0.0f64; 5 * BRACKET_SAMPLES + 4];
+        let mut roots = [0.0f64; 4 * BRACKET_SAMPLES + 4];
         let mut nr = 0;
-        let dominant = |x: f64| {
-            if several {
-                wheel.dominant_flat(x, gamma)
-            } else {
-                None
-            }
-        };
         let mut top0 = dominant(a);
         for s in 1..=m {
             let x1 = if s == m {
@@ -363,8 +446,7 @@ fn adaptive(
             if let (Some(i), Some(j)) = (top0, top1)
                 && i != j
             {
-                let (fi, fj) = (&wheel.flats()[i], &wheel.flats()[j]);
-                let d = |x: f64| fi.reduction_at(x, gamma) - fj.reduction_at(x, gamma);
+                let d = |x: f64| reduction_of(i, x) - reduction_of(j, x);
                 let xc = refine_root(&d, xs[nn - 1], x1);
                 roots[nr] = xc;
                 nr += 1;
@@ -377,30 +459,23 @@ fn adaptive(
             nn += 1;
             top0 = top1;
         }
-        // Sign changes between samples, then slivers: where the samples show a local
-        // maximum of g that is not positive, the true maximum between the neighbours
-        // may be, so it is searched for.
+        // Between two samples: a sign change is a contact end; two non-positive ends
+        // may still hide a sliver of contact where the curvature bound lets g rise
+        // above zero, which is then searched for.
         for k in 0..nn - 1 {
-            if (gs[k] > 0.0) != (gs[k + 1] > 0.0) {
+            let (g0, g1) = (gs[k], gs[k + 1]);
+            if (g0 > 0.0) != (g1 > 0.0) {
                 roots[nr] = refine_root(&g, xs[k], xs[k + 1]);
                 nr += 1;
-            }
-        }
-        for k in 0..nn {
-            let left = if k > 0 { gs[k - 1] } else { f64::NEG_INFINITY };
-            let right = if k + 1 < nn {
-                gs[k + 1]
-            } else {
-                f64::NEG_INFINITY
-            };
-            if gs[k] > 0.0 || gs[k] < left || gs[k] < right {
-                continue;
-            }
-            let (lo, hi) = (xs[k.saturating_sub(1)], xs[(k + 1).min(nn - 1)]);
-            if let Some((r0, r1)) = sliver(&g, lo, xs[k], hi) {
-                roots[nr] = r0;
-                roots[nr + 1] = r1;
-                nr += 2;
+            } else if g0 <= 0.0 {
+                let d = xs[k + 1] - xs[k];
+                if g0.max(g1) + rise * d * d + ROUNDING > 0.0
+                    && let Some((r0, r1)) = sliver(&g, xs[k], g0, xs[k + 1], g1, rise)
+                {
+                    roots[nr] = r0;
+                    roots[nr + 1] = r1;
+                    nr += 2;
+                }
             }
         }
         roots[..nr].sort_unstable_by(|a, b| a.total_cmp(b));
@@ -462,6 +537,10 @@ fn adaptive(
     }
 }
 
+/// Rounding allowance (m) in the curvature test for slivers: far above the rounding
+/// of one evaluation of the integrand (about 1e-16 R_w).
+const ROUNDING: f64 = 1e-15;
+
 /// Capacity of the break-point list of one evaluation.
 const MAX_BREAKS: usize = 4 * MAX_FLATS + 2 * BRACKET_SAMPLES + 8;
 
@@ -508,34 +587,42 @@ fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64) -> f64 {
 }
 
 /// A point of `[lo, hi]` where `g` is positive, if golden-section search for the
-/// maximum of `g` (unimodal there) finds one before the interval shrinks below
-/// 1e-13 rad.
-fn positive_point<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64) -> Option<f64> {
+/// maximum of `g` (unimodal there) finds one; `None` once the values found and the
+/// curvature bound (`g` rises at most `rise w^2` above the larger end value of an
+/// interval `w` wide) show that `g` stays non-positive, or the interval is below
+/// 1e-13 rad. `glo`, `ghi`: `g` at the ends.
+fn positive_point<G: Fn(f64) -> f64>(
+    g: &G,
+    lo: f64,
+    glo: f64,
+    hi: f64,
+    ghi: f64,
+    rise: f64,
+) -> Option<f64> {
     const INV_PHI: f64 = 0.618_033_988_749_894_8;
-    let (mut a, mut b) = (lo, hi);
+    let (mut a, mut b, mut ga, mut gb) = (lo, hi, glo, ghi);
     let mut c = b - INV_PHI * (b - a);
     let mut d = a + INV_PHI * (b - a);
     let (mut gc, mut gd) = (g(c), g(d));
-    for _ in 0..100 {
+    for _ in 0..200 {
         if gc > 0.0 {
             return Some(c);
         }
         if gd > 0.0 {
             return Some(d);
         }
-        if b - a < 1e-13 {
+        let w = (c - a).max(d - c).max(b - d);
+        if b - a < 1e-13 || ga.max(gb).max(gc).max(gd) + rise * w * w + ROUNDING <= 0.0 {
             break;
         }
         if gc > gd {
-            b = d;
-            d = c;
-            gd = gc;
+            (b, gb) = (d, gd);
+            (d, gd) = (c, gc);
             c = b - INV_PHI * (b - a);
             gc = g(c);
         } else {
-            a = c;
-            c = d;
-            gc = gd;
+            (a, ga) = (c, gc);
+            (c, gc) = (d, gd);
             d = a + INV_PHI * (b - a);
             gd = g(d);
         }
@@ -543,13 +630,20 @@ fn positive_point<G: Fn(f64) -> f64>(g: &G, lo: f64, hi: f64) -> Option<f64> {
     None
 }
 
-/// Ends of a contact sliver of `g` around the sample `mid` (where `g <= 0`, as at `lo`
-/// and `hi`), or `None` when `g` stays non-positive on `[lo, hi]`. Each end is
-/// bracketed between the positive point found and the nearest non-positive sample.
-fn sliver<G: Fn(f64) -> f64>(g: &G, lo: f64, mid: f64, hi: f64) -> Option<(f64, f64)> {
-    let xp = positive_point(g, lo, hi)?;
-    let (left, right) = if xp > mid { (mid, hi) } else { (lo, mid) };
-    Some((refine_root(g, left, xp), refine_root(g, xp, right)))
+/// Ends of a contact sliver of `g` between `lo` and `hi`, where `g` is non-positive
+/// (`glo`, `ghi`), or `None` when `g` stays non-positive there (see
+/// [`positive_point`]). Each end is bracketed between the positive point found and
+/// the nearer end of the interval.
+fn sliver<G: Fn(f64) -> f64>(
+    g: &G,
+    lo: f64,
+    glo: f64,
+    hi: f64,
+    ghi: f64,
+    rise: f64,
+) -> Option<(f64, f64)> {
+    let xp = positive_point(g, lo, glo, hi, ghi, rise)?;
+    Some((refine_root(g, lo, xp), refine_root(g, xp, hi)))
 }
 
 fn gauss<G: Fn(f64) -> f64>(g: &G, a: f64, b: f64) -> f64 {
@@ -746,12 +840,34 @@ mod tests {
 
     #[test]
     fn small_arcsine_is_the_arcsine() {
+        // The series patch angle 2 s P(s^2) against the library arcsine, across the
+        // switch to the library at s = 0.05.
         let mut worst: f64 = 0.0;
-        for i in 0..=20_000 {
-            let x = 0.06 * i as f64 / 20_000.0;
-            worst = worst.max(((asin_small(x) - x.asin()) / x.asin().max(1e-300)).abs());
+        for i in 1..=20_000 {
+            let s = 0.06 * i as f64 / 20_000.0;
+            let (a, _, x) = perfect_patch(2.0 * R * s * s, R);
+            let want = 2.0 * x.sqrt().asin();
+            worst = worst.max(((a - want) / want).abs());
         }
-        assert!(worst < 3e-16, "{worst:e}");
+        assert!(worst < 6e-16, "{worst:e}");
+        // The series s^3 Q(s^2) for sin a - a cos a against its alternating Taylor
+        // series in a (no cancellation), summed to convergence in f64.
+        let mut worst: f64 = 0.0;
+        for i in 1..=2_000 {
+            let s = 0.05 * i as f64 / 2_000.0;
+            let (a, got, _) = perfect_patch(2.0 * R * s * s, R);
+            // sum over n >= 1 of (-1)^(n+1) 2n a^(2n+1) / (2n+1)!
+            let (mut term, mut want) = (a * a * a / 3.0, 0.0);
+            for n in 1..30 {
+                want += term;
+                let n = n as f64;
+                term *= -a * a * (2.0 * n + 2.0) / (2.0 * n * (2.0 * n + 2.0) * (2.0 * n + 3.0));
+            }
+            worst = worst.max(((got - want) / want).abs());
+        }
+        // The reference starts from the rounded angle (2 ulp), an error that the
+        // cube-like growth of sin a - a cos a triples.
+        assert!(worst < 2e-15, "sin a - a cos a: {worst:e}");
         // Perfect-wheel patch length from the identity against the direct sine.
         let law = ContactLaw::adaptive(KW).unwrap();
         let w = WheelProfile::perfect(R).unwrap();
@@ -765,19 +881,36 @@ mod tests {
     #[test]
     fn sliver_search_finds_a_narrow_positive_peak() {
         // A peak 1e-12 high and 2e-6 wide at 0.3 that no sample grid would catch.
+        // |g''| = 2: g rises at most w^2 / 4 above the chord of an interval w wide.
+        let rise = 0.25;
         let peak = |x: f64| 1e-12 - (x - 0.3) * (x - 0.3);
-        let xp = positive_point(&peak, 0.0, 1.0).unwrap();
+        let xp = positive_point(&peak, 0.0, peak(0.0), 1.0, peak(1.0), rise).unwrap();
         assert!(peak(xp) > 0.0);
         let below = |x: f64| -1e-12 - (x - 0.3) * (x - 0.3);
-        assert_eq!(positive_point(&below, 0.0, 1.0), None);
-        // Both ends of the sliver, with the peak left or right of the middle sample.
+        assert_eq!(
+            positive_point(&below, 0.0, below(0.0), 1.0, below(1.0), rise),
+            None
+        );
+        // Both ends of the sliver, the peak near either end of the interval.
         let half = 1e-6;
-        for mid in [0.2, 0.4] {
-            let (r0, r1) = sliver(&peak, 0.0, mid, 1.0).unwrap();
-            assert!((r0 - (0.3 - half)).abs() < 1e-9, "mid {mid}: {r0}");
-            assert!((r1 - (0.3 + half)).abs() < 1e-9, "mid {mid}: {r1}");
+        for (lo, hi) in [(0.0, 1.0), (0.25, 0.31), (0.29, 0.9)] {
+            let (r0, r1) = sliver(&peak, lo, peak(lo), hi, peak(hi), rise).unwrap();
+            assert!((r0 - (0.3 - half)).abs() < 1e-9, "[{lo}, {hi}]: {r0}");
+            assert!((r1 - (0.3 + half)).abs() < 1e-9, "[{lo}, {hi}]: {r1}");
         }
-        assert_eq!(sliver(&below, 0.0, 0.4, 1.0), None);
+        assert_eq!(sliver(&below, 0.0, below(0.0), 1.0, below(1.0), rise), None);
+        // A maximum well below zero is dismissed by the curvature bound in a few
+        // evaluations instead of a search down to 1e-13.
+        let count = std::cell::Cell::new(0);
+        let deep = |x: f64| {
+            count.set(count.get() + 1);
+            -1e-6 - (x - 0.3) * (x - 0.3)
+        };
+        assert_eq!(
+            positive_point(&deep, 0.29, deep(0.29), 0.32, deep(0.32), rise),
+            None
+        );
+        assert!(count.get() < 12, "{} evaluations", count.get());
     }
 
     #[test]

@@ -33,9 +33,9 @@ pub fn wrap_angle(a: f64) -> f64 {
 pub fn cos_small(a: f64) -> f64 {
     if a.abs() <= 0.2 {
         let x = a * a;
-        1.0 + x
-            * (-1.0 / 2.0
-                + x * (1.0 / 24.0 + x * (-1.0 / 720.0 + x * (1.0 / 40320.0 - x / 3628800.0))))
+        let (x2, c) = (x * x, &COS_TAYLOR);
+        // Estrin's scheme: (c0 + c1 x) + x^2 (c2 + c3 x) + x^4 (c4 + c5 x).
+        (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2 + (c[4] + c[5] * x) * (x2 * x2)
     } else {
         a.cos()
     }
@@ -48,11 +48,9 @@ pub fn cos_small(a: f64) -> f64 {
 pub fn tan_small(a: f64) -> f64 {
     if a.abs() <= 0.2 {
         let x = a * a;
-        let sin = a
-            * (1.0
-                + x * (-1.0 / 6.0
-                    + x * (1.0 / 120.0
-                        + x * (-1.0 / 5040.0 + x * (1.0 / 362880.0 - x / 39916800.0)))));
+        let (x2, c) = (x * x, &SIN_TAYLOR);
+        let x4 = x2 * x2;
+        let sin = a * ((c[0] + c[1] * x) + (c[2] + c[3] * x) * x2 + (c[4] + c[5] * x) * x4);
         sin / cos_small(a)
     } else {
         a.tan()
@@ -60,30 +58,50 @@ pub fn tan_small(a: f64) -> f64 {
 }
 
 /// `cos a` for `|a| <= pi/2` by its Taylor polynomial to `a^20` (first omitted term
-/// below 2e-17).
+/// below 2e-17), evaluated by Estrin's scheme (a dependency chain of 4
+/// multiply-adds instead of Horner's 10).
 #[inline]
 fn cos_half_pi(a: f64) -> f64 {
     let x = a * a;
-    // Coefficients (-1)^k / (2k)!, k = 0..=10, by Horner's rule from the top.
-    const C: [f64; 11] = [
-        1.0,
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40320.0,
-        -1.0 / 3628800.0,
-        1.0 / 479001600.0,
-        -1.0 / 87178291200.0,
-        1.0 / 20922789888000.0,
-        -1.0 / 6402373705728000.0,
-        1.0 / 2432902008176640000.0,
-    ];
-    let mut r = C[10];
-    for c in C[..10].iter().rev() {
-        r = r * x + c;
-    }
-    r
+    let (x2, c) = (x * x, &COS_TAYLOR);
+    let x4 = x2 * x2;
+    let x8 = x4 * x4;
+    let p01 = c[0] + c[1] * x;
+    let p23 = c[2] + c[3] * x;
+    let p45 = c[4] + c[5] * x;
+    let p67 = c[6] + c[7] * x;
+    let p89 = c[8] + c[9] * x;
+    let p03 = p01 + p23 * x2;
+    let p47 = p45 + p67 * x2;
+    let p810 = p89 + c[10] * x2;
+    (p03 + p47 * x4) + p810 * x8
 }
+
+/// `(-1)^k / (2k + 1)!`, `k = 0..=5`: the sine's Taylor coefficients (over `a`) in
+/// `a^2`.
+const SIN_TAYLOR: [f64; 6] = [
+    1.0,
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5040.0,
+    1.0 / 362880.0,
+    -1.0 / 39916800.0,
+];
+
+/// `(-1)^k / (2k)!`, `k = 0..=10`: the cosine's Taylor coefficients in `a^2`.
+const COS_TAYLOR: [f64; 11] = [
+    1.0,
+    -1.0 / 2.0,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40320.0,
+    -1.0 / 3628800.0,
+    1.0 / 479001600.0,
+    -1.0 / 87178291200.0,
+    1.0 / 20922789888000.0,
+    -1.0 / 6402373705728000.0,
+    1.0 / 2432902008176640000.0,
+];
 
 /// Shape of a flat.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,6 +162,12 @@ pub struct Flat {
     /// for a haversine flat, `acos((R_w - D_f)/R_w)` for a chord flat.
     pub half_angle: f64,
     radius: f64,
+    /// Haversine flat: `pi (R_w - D_f) / l_f` (1/rad... per unit tangent), the phase
+    /// `u = pi x / l_f - pi/2` of (2.16) per `tan psi`.
+    k_tan: f64,
+    /// Upper bound of `|f'(psi)| + |f''(psi)|` over the flat (m/rad, m/rad^2): what
+    /// the flat adds to the curvature of the contact integrand.
+    bend: f64,
 }
 
 impl Flat {
@@ -156,13 +180,13 @@ impl Flat {
         }
         match self.shape {
             FlatShape::Haversine => {
-                // (2.16); x is clamped to [0, l_f] so that the profile is
-                // continuous at the flat ends (the seed's x misses 0 by ~1e-5 l_f).
-                let x = (0.5 * self.length + (self.radius - self.depth) * tan_small(psi))
-                    .clamp(0.0, self.length);
-                // D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l), with
-                // sin(pi x / l) = cos(pi x / l - pi/2) and the argument in [-pi/2, pi/2].
-                let s = cos_half_pi(PI * x / self.length - 0.5 * PI);
+                // (2.16) with x = l_f/2 + (R_w - D_f) tan psi along the flat:
+                // D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l) = D cos^2 u with
+                // u = pi x / l - pi/2 = k_tan tan psi. u is clamped to [-pi/2, pi/2]
+                // (x to [0, l_f]) so that the profile is continuous at the flat ends
+                // (the seed's x misses 0 by ~1e-5 l_f).
+                let u = (self.k_tan * tan_small(psi)).clamp(-0.5 * PI, 0.5 * PI);
+                let s = cos_half_pi(u);
                 self.depth * s * s
             }
             FlatShape::Chord => self.radius - (self.radius - self.depth) / cos_small(psi),
@@ -173,6 +197,36 @@ impl Flat {
     #[inline]
     pub fn reduction_at(&self, alpha: f64, gamma: f64) -> f64 {
         self.reduction(wrap_angle(alpha + gamma - self.angle))
+    }
+
+    /// Upper bound of `|f'| + |f''|` over the flat (m/rad, m/rad^2), `f` the radius
+    /// reduction as a function of the angle: with `R_w`, a bound on the second
+    /// derivative of the contact integrand, which bounds how far it can rise between
+    /// two samples.
+    pub fn bend_bound(&self) -> f64 {
+        self.bend
+    }
+}
+
+/// Upper bound of `|f'| + |f''|` of a flat's reduction `f(psi)` (see
+/// [`Flat::bend_bound`]), from the derivatives of (2.12) and (2.16) bounded
+/// term by term over `|psi| <= h`.
+fn bend_bound(shape: FlatShape, radius: f64, depth: f64, k_tan: f64, h: f64) -> f64 {
+    let (t, sec) = (h.tan(), 1.0 / h.cos());
+    let sec2 = sec * sec;
+    match shape {
+        FlatShape::Haversine => {
+            // f = D cos^2 u, u = k tan psi: f' = -D sin 2u u', f'' = -2D cos 2u u'^2
+            // - D sin 2u u'', u' = k sec^2 psi, u'' = 2 k sec^2 psi tan psi.
+            let du = k_tan * sec2;
+            let d2u = 2.0 * k_tan * sec2 * t;
+            depth * du + 2.0 * depth * du * du + depth * d2u
+        }
+        FlatShape::Chord => {
+            // f = R - (R - D) sec psi: f' = -(R - D) sec tan, f'' = -(R - D) sec (sec^2 + tan^2).
+            let rd = radius - depth;
+            rd * sec * t + rd * sec * (sec2 + t * t)
+        }
     }
 }
 
@@ -319,6 +373,7 @@ fn validate_flat(radius: f64, spec: &FlatSpec, p: &str) -> Result<Option<Flat>> 
         FlatShape::Haversine => length / (2.0 * radius),
         FlatShape::Chord => ((radius - depth) / radius).acos(),
     };
+    let k_tan = PI * (radius - depth) / length;
     Ok(Some(Flat {
         shape: spec.shape,
         length,
@@ -326,6 +381,8 @@ fn validate_flat(radius: f64, spec: &FlatSpec, p: &str) -> Result<Option<Flat>> 
         angle,
         half_angle,
         radius,
+        k_tan,
+        bend: bend_bound(spec.shape, radius, depth, k_tan, half_angle),
     }))
 }
 
