@@ -104,6 +104,21 @@ fn wheel_loads(x: f64, p: [f64; 2]) -> [PointLoad; 2] {
     ]
 }
 
+/// Angle `a` (rad) wrapped into [0, 2 pi).
+///
+/// The whole number of turns is taken off by truncation rather than `rem_euclid`
+/// (a libm `fmod` call): the result differs by a rounding of the turns removed,
+/// which is below the rounding already in the unwrapped angle.
+#[inline]
+fn wrap_turns(a: f64) -> f64 {
+    use std::f64::consts::TAU;
+    if !a.is_finite() || a.abs() > 1e15 {
+        return a.rem_euclid(TAU);
+    }
+    let r = a - (a * (1.0 / TAU)) as i64 as f64 * TAU;
+    if r < 0.0 { r + TAU } else { r }
+}
+
 /// Time step used when the scenario asks for the default (`dt = 0`) (s).
 pub fn default_dt(scenario: &Scenario) -> f64 {
     match &scenario.track {
@@ -264,20 +279,6 @@ impl Simulation {
         }
     }
 
-    /// Axle rotation angle wrapped into [0, 2 pi) (rad): what places the flats.
-    ///
-    /// The whole number of turns is taken off by truncation rather than `rem_euclid`
-    /// (a libm `fmod` call): the result differs by a rounding of the turns removed,
-    /// which is below the rounding already in the unwrapped angle.
-    fn rotation_wrapped(&self) -> f64 {
-        use std::f64::consts::TAU;
-        let a = self.rotation();
-        if !a.is_finite() || a.abs() > 1e15 {
-            return a.rem_euclid(TAU);
-        }
-        let r = a - (a * (1.0 / TAU)) as i64 as f64 * TAU;
-        if r < 0.0 { r + TAU } else { r }
-    }
     /// Static wheel loads (N).
     pub fn static_load(&self) -> [f64; 2] {
         self.static_load
@@ -347,7 +348,7 @@ impl Simulation {
     pub fn rail_z(&self) -> [f64; 2] {
         let x = self.position();
         match &self.track {
-            TrackState::Discrete(t) => [t.rail_z_at(0, x), t.rail_z_at(1, x)],
+            TrackState::Discrete(t) => t.rail_z_pair(x),
             TrackState::Lumped(t) => t.rail_z(),
         }
     }
@@ -363,10 +364,15 @@ impl Simulation {
     }
 
     fn compute_sample(&self) -> Sample {
+        let time = self.time();
+        let position = self.scenario.start_position + self.scenario.speed * time;
         let wheel_z = self.wheel_z();
-        let rail_z = self.rail_z();
+        let rail_z = match &self.track {
+            TrackState::Discrete(t) => t.rail_z_pair(position),
+            TrackState::Lumped(t) => t.rail_z(),
+        };
         let rotation = self.rotation();
-        let gamma = self.rotation_wrapped();
+        let gamma = wrap_turns(rotation);
         let contact = match &self.vehicle {
             VehicleState::ConstantLoad(p) => [
                 ContactState {
@@ -388,8 +394,8 @@ impl Simulation {
             ],
         };
         Sample {
-            time: self.time(),
-            position: self.position(),
+            time,
+            position,
             rotation,
             wheel_z,
             rail_z,

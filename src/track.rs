@@ -768,6 +768,19 @@ impl Track {
         (1.0 - w) * self.z[self.slot_of(rail, k)] + w * self.z[self.slot_of(rail, k + 1)]
     }
 
+    /// Rail deflections (m) under position `x` on the left and right rail, (3.23):
+    /// [`Track::rail_z_at`] of both rails, located once.
+    #[inline]
+    pub fn rail_z_pair(&self, x: f64) -> [f64; 2] {
+        let (k, w) = self.locate(x);
+        let (s0, s1) = (self.slot[k], self.slot[k + 1]);
+        let sp = self.sp;
+        [
+            (1.0 - w) * self.z[s0] + w * self.z[s1],
+            (1.0 - w) * self.z[s0 + sp] + w * self.z[s1 + sp],
+        ]
+    }
+
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
     pub fn step(&mut self, loads: &[PointLoad]) {
         let (inv_dx, nk) = (self.inv_dx, self.nk);
