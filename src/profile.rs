@@ -162,8 +162,8 @@ pub struct Flat {
     /// for a haversine flat, `acos((R_w - D_f)/R_w)` for a chord flat.
     pub half_angle: f64,
     radius: f64,
-    /// Haversine flat: `pi (R_w - D_f) / l_f` (1/rad... per unit tangent), the phase
-    /// `u = pi x / l_f - pi/2` of (2.16) per `tan psi`.
+    /// Haversine flat: `pi (R_w - D_f) / l_f` (dimensionless), the phase
+    /// `u = pi x / l_f - pi/2` of (2.16) per unit of `tan psi`.
     k_tan: f64,
     /// Upper bound of `|f'(psi)| + |f''(psi)|` over the flat (m/rad, m/rad^2): what
     /// the flat adds to the curvature of the contact integrand.

@@ -346,7 +346,11 @@ impl Simulation {
 
     /// Rail displacements under the wheels (m) (3.23).
     pub fn rail_z(&self) -> [f64; 2] {
-        let x = self.position();
+        self.rail_z_under(self.position())
+    }
+
+    /// Rail displacements (m) under wheels at position `x` (m).
+    fn rail_z_under(&self, x: f64) -> [f64; 2] {
         match &self.track {
             TrackState::Discrete(t) => t.rail_z_pair(x),
             TrackState::Lumped(t) => t.rail_z(),
@@ -367,10 +371,7 @@ impl Simulation {
         let time = self.time();
         let position = self.scenario.start_position + self.scenario.speed * time;
         let wheel_z = self.wheel_z();
-        let rail_z = match &self.track {
-            TrackState::Discrete(t) => t.rail_z_pair(position),
-            TrackState::Lumped(t) => t.rail_z(),
-        };
+        let rail_z = self.rail_z_under(position);
         let rotation = self.rotation();
         let gamma = wrap_turns(rotation);
         let contact = match &self.vehicle {

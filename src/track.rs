@@ -369,7 +369,7 @@ impl SimdLevel {
 /// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
 /// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to
 /// `S`, a multiple of 4, node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
-/// (`G` = [`GUARD`] unused values in front). Block 0 (`k % n = 0`) therefore holds the
+/// (`G` = 4 unused values in front, as many behind). Block 0 (`k % n = 0`) therefore holds the
 /// rail nodes above the sleepers, left rail then right rail, in sleeper order, and
 /// the sleeper loop reads it directly; every block is stepped whole, its first and
 /// last neighbours reading the guards. Slots past a rail's last node (one per rail in
@@ -426,7 +426,7 @@ fn locate(x: f64, inv_dx: f64, nk: usize) -> (usize, f64) {
 
 /// Unused values in front of and behind the phase-blocked rail arrays: the first
 /// slot of block 0 and the last of block `n - 1` read one of them as a neighbour.
-pub const GUARD: usize = 4;
+const GUARD: usize = 4;
 
 /// Pad forces (3.9) and sleeper update (3.18) for every sleeper: rail deflections
 /// above the sleepers at t_j (`rl`, `rr`) and t_(j-1) (`rlp`, `rrp`), sleeper bounce
