@@ -75,8 +75,8 @@ pub fn kw_from_hertz(ch: f64, static_load: f64, radius: f64) -> Result<f64> {
             "large enough that the static overlap is below the wheel radius",
         ));
     }
-    let a = patch_angle(delta0, radius);
-    Ok(static_load / (2.0 * radius * sin_minus_x_cos(a)))
+    // The same closed form the adaptive law evaluates, so P(delta_0) = P_0 to rounding.
+    Ok(static_load / (2.0 * radius * perfect_patch(delta0, radius).1))
 }
 
 /// Perfect-wheel patch angle `alpha_w = acos((R_w - delta)/R_w)` (2.6), computed as
@@ -140,20 +140,6 @@ const SIN_MINUS_X_COS_OVER_S3: [f64; 7] = [
     63.0 / 4576.0,
     77.0 / 8320.0,
 ];
-
-/// `sin a - a cos a`, by its series below 0.1 rad to avoid cancellation.
-#[inline]
-pub fn sin_minus_x_cos(a: f64) -> f64 {
-    if a.abs() < 0.1 {
-        let a2 = a * a;
-        // a^3/3 - a^5/30 + a^7/840 - a^9/45360 + a^11/3991680
-        a * a2
-            * (1.0 / 3.0
-                + a2 * (-1.0 / 30.0 + a2 * (1.0 / 840.0 + a2 * (-1.0 / 45360.0 + a2 / 3991680.0))))
-    } else {
-        a.sin() - a * a.cos()
-    }
-}
 
 /// `sin a - a`, by its series below 0.1 rad.
 #[inline]
