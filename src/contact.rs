@@ -224,6 +224,7 @@ impl ContactLaw {
 
     /// Contact state for a wheel with profile `wheel` at axle rotation `gamma` (rad)
     /// and overlap `overlap = z_rail - z_wheel` (m).
+    #[inline(always)]
     pub fn evaluate(&self, wheel: &WheelProfile, gamma: f64, overlap: f64) -> ContactState {
         match self.model {
             ContactModel::Adaptive => adaptive(self.kw, wheel, gamma, overlap, false),
@@ -287,6 +288,7 @@ pub fn adaptive_numeric(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f64)
     adaptive(kw, wheel, gamma, overlap, true)
 }
 
+#[inline(always)]
 fn adaptive(
     kw: f64,
     wheel: &WheelProfile,

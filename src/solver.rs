@@ -9,7 +9,7 @@ use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
 use crate::error::{Error, Result, finite, non_negative, out_of_range, positive};
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
-use crate::track::{PointLoad, Track};
+use crate::track::{PointLoad, SimdLevel, Track};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use std::cell::Cell;
 
@@ -86,6 +86,8 @@ pub struct Simulation {
     /// The sample at the current time and inputs, once computed (a co-simulation
     /// master reads the outputs and then steps: the contact is evaluated once).
     cached: Cell<Option<Sample>>,
+    /// Instructions the whole coupled step is compiled for (see [`Simulation::step`]).
+    simd: SimdLevel,
 }
 
 /// The two wheel loads `p` (N) at position `x` (m), left and right rail.
@@ -215,6 +217,7 @@ impl Simulation {
             max_force: [f64::NEG_INFINITY; 2],
             min_force: [f64::INFINITY; 2],
             cached: Cell::new(None),
+            simd: SimdLevel::detect(),
         };
         sim.set_static()?;
         Ok(sim)
@@ -350,6 +353,7 @@ impl Simulation {
     }
 
     /// Rail displacements (m) under wheels at position `x` (m).
+    #[inline(always)]
     fn rail_z_under(&self, x: f64) -> [f64; 2] {
         match &self.track {
             TrackState::Discrete(t) => t.rail_z_pair(x),
@@ -367,6 +371,7 @@ impl Simulation {
         s
     }
 
+    #[inline(always)]
     fn compute_sample(&self) -> Sample {
         let time = self.time();
         let position = self.scenario.start_position + self.scenario.speed * time;
@@ -404,8 +409,51 @@ impl Simulation {
         }
     }
 
+    /// Instructions the coupled step runs with.
+    pub fn simd(&self) -> SimdLevel {
+        self.simd
+    }
+
+    /// Makes the coupled step (track loops included) use `level`; refused when this
+    /// CPU lacks it. Every level gives bit-identical results.
+    pub fn set_simd(&mut self, level: SimdLevel) -> Result<()> {
+        if let TrackState::Discrete(t) = &mut self.track {
+            t.set_simd(level)?;
+        } else if level > SimdLevel::detect() {
+            return Err(Error::Unsupported(format!(
+                "simd = {level:?}: this CPU supports up to {:?}",
+                SimdLevel::detect()
+            )));
+        }
+        self.simd = level;
+        Ok(())
+    }
+
     /// Advances one step and returns the sample at `t_j` whose contact forces drove it.
+    ///
+    /// The whole step (sample, contact, vehicle, track) is compiled once per
+    /// [`SimdLevel`] and dispatched here: with AVX2 the scalar code gets three-operand
+    /// instructions and the vehicle's 6 x 6 products whole 4-lane vectors. No FMA is
+    /// enabled, so the arithmetic, and every result, is the same at every level.
     pub fn step(&mut self) -> Result<Sample> {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2")]
+            fn avx2(sim: &mut Simulation) -> Result<Sample> {
+                sim.step_body()
+            }
+            if self.simd == SimdLevel::Avx2 {
+                // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
+                // `Simulation::set_simd`).
+                return unsafe { avx2(self) };
+            }
+        }
+        self.step_body()
+    }
+
+    /// [`Simulation::step`], inlined into each level's copy.
+    #[inline(always)]
+    fn step_body(&mut self) -> Result<Sample> {
         let x = self.position();
         if let TrackState::Discrete(t) = &self.track {
             let len = t.params().length();

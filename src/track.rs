@@ -770,7 +770,7 @@ impl Track {
 
     /// Rail deflections (m) under position `x` on the left and right rail, (3.23):
     /// [`Track::rail_z_at`] of both rails, located once.
-    #[inline]
+    #[inline(always)]
     pub fn rail_z_pair(&self, x: f64) -> [f64; 2] {
         let (k, w) = self.locate(x);
         let (s0, s1) = (self.slot[k], self.slot[k + 1]);
@@ -782,6 +782,7 @@ impl Track {
     }
 
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
+    #[inline(always)]
     pub fn step(&mut self, loads: &[PointLoad]) {
         let (inv_dx, nk) = (self.inv_dx, self.nk);
         let Track {

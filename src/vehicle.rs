@@ -309,7 +309,7 @@ impl RollPlaneVehicle {
     }
 
     /// Generalised force vector `F` for contact forces `[P_l, P_r]` (N).
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, p: [f64; 2]) -> Vector6<f64> {
         let mut f = self.gravity;
         f[4] += p[0] + p[1];
@@ -318,7 +318,7 @@ impl RollPlaneVehicle {
     }
 
     /// Advances from t_j to t_(j+1) under contact forces `[P_l, P_r]` (N) at t_j.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self, p: [f64; 2]) {
         // p_force * force(p), the constant part precomputed: the contact forces act
         // on the wheelset's bounce and roll only (where they nearly cancel its weight,

@@ -48,6 +48,34 @@ fn starts_in_static_equilibrium_and_stays_there_at_rest() {
 }
 
 #[test]
+fn every_simd_level_gives_the_same_samples_bit_for_bit() {
+    // The coupled step is compiled once per level (no FMA anywhere): through a flat
+    // impact, with loss of contact and a split patch, every sample must be identical
+    // to the baseline build's, bit for bit.
+    use wheelflat::track::SimdLevel;
+    let base = Simulation::new(&seed_grid(Scenario::table_4_4_flat())).unwrap();
+    let run = |level: SimdLevel| {
+        let mut sim = base.clone();
+        sim.set_simd(level).unwrap();
+        assert_eq!(sim.simd(), level);
+        (0..4000).map(|_| sim.step().unwrap()).collect::<Vec<_>>()
+    };
+    let reference = run(SimdLevel::Baseline);
+    // The window holds the impact (contact lost, then more than 3 x static).
+    let w = base.static_load()[0];
+    assert!(reference.iter().any(|x| x.contact[0].lost()));
+    assert!(reference.iter().any(|x| x.contact[0].force > 3.0 * w));
+    for level in SimdLevel::available() {
+        let other = run(level);
+        for (a, b) in reference.iter().zip(&other) {
+            let (fa, fb) = (a.contact[0].force, b.contact[0].force);
+            assert_eq!(fa.to_bits(), fb.to_bits(), "{level:?} at t = {}", a.time);
+            assert_eq!(a, b, "{level:?} at t = {}", a.time);
+        }
+    }
+}
+
+#[test]
 fn perfect_wheel_at_100_kmh_matches_seed_force_band() {
     // Seed section 4.3.1 (table 4.4, 20 spans, n = 2, dt = 45 us): steady-state contact
     // force between about 105.8 and 113 kN.
