@@ -433,8 +433,10 @@ impl Simulation {
     ///
     /// The whole step (sample, contact, vehicle, track) is compiled once per
     /// [`SimdLevel`] and dispatched here: with AVX2 the scalar code gets three-operand
-    /// instructions and the vehicle's 6 x 6 products whole 4-lane vectors. No FMA is
-    /// enabled, so the arithmetic, and every result, is the same at every level.
+    /// instructions and the vehicle's 6 x 6 products whole 4-lane vectors (an AVX-512
+    /// CPU runs this copy too, with the track loops in their AVX-512 form). Nothing
+    /// is contracted into FMA, so the arithmetic, and every result, is the same at
+    /// every level.
     pub fn step(&mut self) -> Result<Sample> {
         #[cfg(target_arch = "x86_64")]
         {
@@ -442,7 +444,7 @@ impl Simulation {
             fn avx2(sim: &mut Simulation) -> Result<Sample> {
                 sim.step_body()
             }
-            if self.simd == SimdLevel::Avx2 {
+            if self.simd >= SimdLevel::Avx2 {
                 // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
                 // `Simulation::set_simd`).
                 return unsafe { avx2(self) };

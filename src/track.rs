@@ -326,20 +326,22 @@ impl Coeffs {
     }
 }
 
-/// Vector instructions the track stepper's loops run with. The level is detected
-/// once when a track is built ([`SimdLevel::detect`]); [`Track::set_simd`] picks
-/// another (for benchmarks and for checking that the levels agree). No FMA is used,
-/// so every level gives bit-identical results. Ordered narrowest first.
-///
-/// There is no AVX-512 level: on the Xeon (Sapphire Rapids) machines we run on, the
-/// same loops compiled for AVX-512F took 352 ns per track step against 266 ns with
-/// AVX2 (reference case, n = 2; `examples/profile_step`).
+/// Vector instructions the track stepper's loops (and [`crate::solver::Simulation`]'s
+/// coupled step) run with. The level is detected once when a track is built
+/// ([`SimdLevel::detect`]); [`Track::set_simd`] picks another (for benchmarks and for
+/// checking that the levels agree). No FMA is used, so every level gives
+/// bit-identical results. Ordered narrowest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdLevel {
     /// Whatever the build target allows (SSE2 on x86-64).
     Baseline,
     /// AVX2: 4 lanes of f64.
     Avx2,
+    /// AVX-512F: 8 lanes of f64 in the track loops (the rest of the coupled step is
+    /// compiled as for AVX2). On the Sapphire Rapids machines we run on, the track
+    /// step of the reference case (n = 2) takes 155-161 ns against 181-292 ns with
+    /// AVX2 (`examples/profile_step`, interleaved runs).
+    Avx512,
 }
 
 impl SimdLevel {
@@ -347,6 +349,9 @@ impl SimdLevel {
     pub fn detect() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return SimdLevel::Avx512;
+            }
             if std::arch::is_x86_feature_detected!("avx2") {
                 return SimdLevel::Avx2;
             }
@@ -357,18 +362,22 @@ impl SimdLevel {
     /// Every level this CPU supports, narrowest first.
     pub fn available() -> Vec<Self> {
         let top = Self::detect();
-        [SimdLevel::Baseline, SimdLevel::Avx2]
+        [SimdLevel::Baseline, SimdLevel::Avx2, SimdLevel::Avx512]
             .into_iter()
             .filter(|l| *l <= top)
             .collect()
     }
 }
 
+/// Lanes of the widest vectors: the sleeper arrays and each rail's part of a block
+/// are padded to a multiple of this, so that every loop runs in whole vectors.
+const LANES: usize = 8;
+
 /// Track state and its explicit time stepper.
 ///
 /// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
 /// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to
-/// `S`, a multiple of 4, node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
+/// `S`, a multiple of [`LANES`], node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
 /// (`G` = 4 unused values in front, as many behind). Block 0 (`k % n = 0`) therefore holds the
 /// rail nodes above the sleepers, left rail then right rail, in sleeper order, and
 /// the sleeper loop reads it directly; every block is stepped whole, its first and
@@ -387,7 +396,7 @@ pub struct Track {
     nk: usize,
     /// Sleepers `N_s = N + 1`.
     ns: usize,
-    /// Sleepers padded to a multiple of 4, `S`: the length of the sleeper arrays and
+    /// Sleepers padded to a multiple of [`LANES`], `S`: the length of the sleeper arrays and
     /// of each rail's part of a block.
     sp: usize,
     c: Coeffs,
@@ -433,7 +442,7 @@ const GUARD: usize = 4;
 /// and roll at t_j (`zs`, `ph`) and t_(j-1) (`zsp`, `php`, overwritten with t_(j+1)),
 /// pad forces out (`pl`, `pr`). Separate slice arguments (not a struct of slices) so
 /// that the compiler knows they do not alias and vectorises without runtime checks.
-/// Slices are as long as `zs`, a multiple of 4.
+/// Slices are as long as `zs`, a multiple of [`LANES`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn sleepers_body(
@@ -515,9 +524,15 @@ macro_rules! simd_kernel {
                 fn avx2($($arg: $ty),*) {
                     $body($($arg),*)
                 }
+                #[allow(clippy::too_many_arguments)]
+                #[target_feature(enable = "avx512f")]
+                fn avx512($($arg: $ty),*) {
+                    $body($($arg),*)
+                }
                 match simd {
                     // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
                     // `Track::set_simd`).
+                    SimdLevel::Avx512 => return unsafe { avx512($($arg),*) },
                     SimdLevel::Avx2 => return unsafe { avx2($($arg),*) },
                     SimdLevel::Baseline => {}
                 }
@@ -614,7 +629,7 @@ impl Track {
         let n = params.nodes_per_span;
         let nk = params.spans * n + 1;
         let ns = params.spans + 1;
-        let sp = ns.next_multiple_of(4);
+        let sp = ns.next_multiple_of(LANES);
         let c = Coeffs::new(&params, dt);
         let b = 2 * sp;
         let len = GUARD + n * b + GUARD;
