@@ -373,12 +373,52 @@ impl SimdLevel {
 /// are padded to a multiple of this, so that every loop runs in whole vectors.
 const LANES: usize = 8;
 
+/// One cache line of values.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+struct Line([f64; LANES]);
+
+/// Values starting on a cache line, so that with the guards a whole multiple of
+/// [`LANES`] long, every block starts on one too and its centre loads and stores never
+/// straddle two lines (a vector that does costs two loads).
+#[derive(Debug, Clone)]
+struct Aligned {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+impl Aligned {
+    /// `len` zeros.
+    fn zeros(len: usize) -> Self {
+        Aligned {
+            lines: vec![Line([0.0; LANES]); len.div_ceil(LANES)],
+            len,
+        }
+    }
+}
+
+impl std::ops::Deref for Aligned {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        // SAFETY: `Line` is `repr(C)` around `[f64; LANES]`, so the lines are
+        // `LANES * lines.len() >= len` contiguous, initialised f64 values.
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+impl std::ops::DerefMut for Aligned {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        // SAFETY: as in `deref`, and `&mut self` borrows the lines uniquely.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<f64>(), self.len) }
+    }
+}
+
 /// Track state and its explicit time stepper.
 ///
 /// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
 /// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to
 /// `S`, a multiple of [`LANES`], node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
-/// (`G` = 4 unused values in front, as many behind). Block 0 (`k % n = 0`) therefore holds the
+/// (`G` = [`LANES`] unused values in front, as many behind; arrays start on a cache line, so every block does too). Block 0 (`k % n = 0`) therefore holds the
 /// rail nodes above the sleepers, left rail then right rail, in sleeper order, and
 /// the sleeper loop reads it directly; every block is stepped whole, its first and
 /// last neighbours reading the guards. Slots past a rail's last node (one per rail in
@@ -408,18 +448,18 @@ pub struct Track {
     /// right rail), each with the slot of its inner neighbour node.
     ends_inner: [(usize, usize); 4],
     /// Rail deflection at t_j (m), phase-blocked.
-    z: Vec<f64>,
+    z: Aligned,
     /// Rail rotation at t_j (rad), phase-blocked.
-    th: Vec<f64>,
-    z_prev: Vec<f64>,
-    th_prev: Vec<f64>,
-    zs: Vec<f64>,
-    ph: Vec<f64>,
-    zs_prev: Vec<f64>,
-    ph_prev: Vec<f64>,
+    th: Aligned,
+    z_prev: Aligned,
+    th_prev: Aligned,
+    zs: Aligned,
+    ph: Aligned,
+    zs_prev: Aligned,
+    ph_prev: Aligned,
     /// Pad forces on the rails (N): left rail sleepers at `0..N_s`, right rail
     /// sleepers at `S..S + N_s`.
-    pad: Vec<f64>,
+    pad: Aligned,
     simd: SimdLevel,
 }
 
@@ -434,8 +474,9 @@ fn locate(x: f64, inv_dx: f64, nk: usize) -> (usize, f64) {
 }
 
 /// Unused values in front of and behind the phase-blocked rail arrays: the first
-/// slot of block 0 and the last of block `n - 1` read one of them as a neighbour.
-const GUARD: usize = 4;
+/// slot of block 0 and the last of block `n - 1` read one of them as a neighbour. A
+/// whole vector of them, so that blocks start on a cache line.
+const GUARD: usize = LANES;
 
 /// Pad forces (3.9) and sleeper update (3.18) for every sleeper: rail deflections
 /// above the sleepers at t_j (`rl`, `rr`) and t_(j-1) (`rlp`, `rrp`), sleeper bounce
@@ -658,15 +699,15 @@ impl Track {
             slot,
             padding,
             ends_inner,
-            z: vec![0.0; len],
-            th: vec![0.0; len],
-            z_prev: vec![0.0; len],
-            th_prev: vec![0.0; len],
-            zs: vec![0.0; sp],
-            ph: vec![0.0; sp],
-            zs_prev: vec![0.0; sp],
-            ph_prev: vec![0.0; sp],
-            pad: vec![0.0; 2 * sp],
+            z: Aligned::zeros(len),
+            th: Aligned::zeros(len),
+            z_prev: Aligned::zeros(len),
+            th_prev: Aligned::zeros(len),
+            zs: Aligned::zeros(sp),
+            ph: Aligned::zeros(sp),
+            zs_prev: Aligned::zeros(sp),
+            ph_prev: Aligned::zeros(sp),
+            pad: Aligned::zeros(2 * sp),
             simd: SimdLevel::detect(),
         }
     }
@@ -1134,7 +1175,7 @@ impl Track {
             (&self.zs, &mut self.zs_prev),
             (&self.ph, &mut self.ph_prev),
         ] {
-            for (p, c) in prev.iter_mut().zip(cur) {
+            for (p, c) in prev.iter_mut().zip(cur.iter()) {
                 *p = c - (c - *p) * ratio;
             }
         }
@@ -1502,7 +1543,7 @@ mod tests {
         for _ in 0..100 {
             stat.step(&loads);
         }
-        for (a, b) in before.iter().zip(&stat.z) {
+        for (a, b) in before.iter().zip(stat.z.iter()) {
             assert!((a - b).abs() < 1e-12 * zs.abs());
         }
     }
