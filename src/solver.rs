@@ -467,11 +467,21 @@ impl Simulation {
                 });
             }
         }
-        // The cached sample, if the outputs were read at this instant, is used up here.
-        let s = match self.cached.take() {
-            Some(s) => s,
-            None => self.compute_sample(),
-        };
+        // The cached sample, if the outputs were read at this instant, is used up here;
+        // otherwise the sample is built where it is returned (no copies on the way).
+        if let Some(s) = self.cached.take() {
+            self.advance_with(x, &s)?;
+            return Ok(s);
+        }
+        let s = self.compute_sample();
+        self.advance_with(x, &s)?;
+        Ok(s)
+    }
+
+    /// Advances vehicle and track from `t_j` with the contact forces of `s`, the sample
+    /// at `t_j`, the wheels at position `x` (m).
+    #[inline(always)]
+    fn advance_with(&mut self, x: f64, s: &Sample) -> Result<()> {
         let p = [s.contact[0].force, s.contact[1].force];
         if !(p[0].is_finite() && p[1].is_finite()) {
             return Err(Error::NonFinite {
@@ -494,7 +504,7 @@ impl Simulation {
         }
         self.steps += 1;
         self.k += 1;
-        Ok(s)
+        Ok(())
     }
 
     /// Changes the time step to `dt` (s) from now on (track and vehicle keep their
