@@ -864,7 +864,10 @@ impl Track {
         let (sp, simd) = (*sp, *simd);
         let n = params.nodes_per_span;
         // The stencil overwrites every slot; pinned ends need their t_(j-1) rotation.
-        let th_prev_ends = ends_inner.map(|(e, _)| th_prev[e]);
+        let th_prev_ends = match params.ends {
+            RailEnds::Pinned => ends_inner.map(|(e, _)| th_prev[e]),
+            RailEnds::Fixed => [0.0; 4],
+        };
         // 1-2. Sleepers and pads, then the rail stencil (see `kernels_body`).
         kernels(
             simd, z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, c, n,
