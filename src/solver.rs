@@ -366,9 +366,28 @@ impl Simulation {
         if let Some(s) = self.cached.get() {
             return s;
         }
-        let s = self.compute_sample();
+        let s = self.compute_sample_dispatched();
         self.cached.set(Some(s));
         s
+    }
+
+    /// [`Simulation::compute_sample`] compiled for the SIMD level, as in
+    /// [`Simulation::step`] (a co-simulation master reads the outputs before it steps,
+    /// so this is where its contact forces are computed).
+    fn compute_sample_dispatched(&self) -> Sample {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2")]
+            fn avx2(sim: &Simulation) -> Sample {
+                sim.compute_sample()
+            }
+            if self.simd >= SimdLevel::Avx2 {
+                // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
+                // `Simulation::set_simd`).
+                return unsafe { avx2(self) };
+            }
+        }
+        self.compute_sample()
     }
 
     #[inline(always)]

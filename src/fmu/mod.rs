@@ -654,7 +654,6 @@ impl Instance {
                 Phase::Terminated,
             ],
         )?;
-        let mut specs = Vec::with_capacity(vrs.len());
         let mut needs_model = false;
         for &r in vrs {
             let s = self.spec(call, r)?;
@@ -663,7 +662,6 @@ impl Instance {
                 s.causality,
                 Causality::Output | Causality::CalculatedParameter
             );
-            specs.push(s);
         }
         if needs_model {
             self.ensure_model()?;
