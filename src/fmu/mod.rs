@@ -612,9 +612,9 @@ impl Instance {
 
     // ---------------------------------------------------------------- variables
 
-    fn spec(&mut self, call: &str, r: u32) -> FmiResult<VarSpec> {
+    fn spec(&mut self, call: &str, r: u32) -> FmiResult<&'static VarSpec> {
         match self.slot.get(r as usize).copied().flatten() {
-            Some(i) => Ok(self.kind.table().vars[i]),
+            Some(i) => Ok(&self.kind.table().vars[i]),
             None => self.refuse(
                 Status::Error,
                 format!(
@@ -626,8 +626,8 @@ impl Instance {
     }
 
     /// The spec of a value reference already checked by [`Instance::spec`].
-    fn known_spec(&self, r: u32) -> VarSpec {
-        self.kind.table().vars[self.slot[r as usize].unwrap_or_default()]
+    fn known_spec(&self, r: u32) -> &'static VarSpec {
+        &self.kind.table().vars[self.slot[r as usize].unwrap_or_default()]
     }
 
     fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
@@ -657,7 +657,7 @@ impl Instance {
         let mut needs_model = false;
         for &r in vrs {
             let s = self.spec(call, r)?;
-            self.check_type(call, &s, real)?;
+            self.check_type(call, s, real)?;
             needs_model |= matches!(
                 s.causality,
                 Causality::Output | Causality::CalculatedParameter
@@ -757,7 +757,7 @@ impl Instance {
         )?;
         for (&r, &x) in vrs.iter().zip(vals) {
             let s = self.spec(call, r)?;
-            self.check_type(call, &s, real)?;
+            self.check_type(call, s, real)?;
             let settable = matches!(
                 (s.causality, self.phase),
                 (Causality::Input, _)
