@@ -125,7 +125,8 @@ fn wrap_turns(a: f64) -> f64 {
 /// AVX2, into which `f` and everything it calls `#[inline(always)]` are inlined. Mark
 /// the closure `#[inline(always)]` too: otherwise it stays a function of its own,
 /// compiled for the baseline (1,096 instead of 870 instructions in the step).
-/// Nothing is contracted into FMA at any level, so results do not depend on it.
+/// Nothing in it is contracted into FMA (the track loops it calls are, at AVX2 and
+/// AVX-512: see [`SimdLevel`]).
 #[inline(always)]
 fn at_level<R>(level: SimdLevel, f: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
@@ -448,7 +449,8 @@ impl Simulation {
     }
 
     /// Makes the coupled step (track loops included) use `level`; refused when this
-    /// CPU lacks it. Every level gives bit-identical results.
+    /// CPU lacks it. AVX2 and AVX-512 give bit-identical results; the baseline, which
+    /// rounds the track loops' products separately, agrees with them to rounding.
     pub fn set_simd(&mut self, level: SimdLevel) -> Result<()> {
         if let TrackState::Discrete(t) = &mut self.track {
             t.set_simd(level)?;
@@ -467,9 +469,9 @@ impl Simulation {
     /// The whole step (sample, contact, vehicle, track) is compiled once per
     /// [`SimdLevel`] and dispatched here: with AVX2 the scalar code gets three-operand
     /// instructions and the vehicle's 6 x 6 products whole 4-lane vectors (an AVX-512
-    /// CPU runs this copy too, with the track loops in their AVX-512 form). Nothing
-    /// is contracted into FMA, so the arithmetic, and every result, is the same at
-    /// every level.
+    /// CPU runs this copy too, with the track loops in their AVX-512 form). Only the
+    /// track loops use FMA, the same way at AVX2 and AVX-512, so those two give the
+    /// same results bit for bit (see [`SimdLevel`]).
     pub fn step(&mut self) -> Result<Sample> {
         at_level(
             self.simd,

@@ -329,26 +329,34 @@ impl Coeffs {
 /// Vector instructions the track stepper's loops (and [`crate::solver::Simulation`]'s
 /// coupled step) run with. The level is detected once when a track is built
 /// ([`SimdLevel::detect`]); [`Track::set_simd`] picks another (for benchmarks and for
-/// checking that the levels agree). No FMA is used, so every level gives
-/// bit-identical results. Ordered narrowest first.
+/// checking that the levels agree). Ordered narrowest first.
+///
+/// Rounding: the AVX2 and AVX-512 levels fuse the track loops' products and sums
+/// (FMA, one rounding each) and give bit-identical results to each other; the
+/// baseline rounds every product (no FMA there: the library `fma` would make its
+/// track step 15 times slower) and agrees with them to rounding. Nothing outside
+/// the track loops is fused at any level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdLevel {
-    /// Whatever the build target allows (SSE2 on x86-64).
+    /// Whatever the build target allows (SSE2 on x86-64), products rounded.
     Baseline,
-    /// AVX2: 4 lanes of f64.
+    /// AVX2 with FMA: 4 lanes of f64.
     Avx2,
-    /// AVX-512F: 8 lanes of f64 in the track loops (the rest of the coupled step is
-    /// compiled as for AVX2). On the Sapphire Rapids machines we run on, the track
-    /// step of the reference case (n = 2) takes 155-161 ns against 181-292 ns with
-    /// AVX2 (`examples/profile_step`, interleaved runs).
+    /// AVX-512F with FMA: 8 lanes of f64 in the track loops (the rest of the coupled
+    /// step is compiled as for AVX2). On the Sapphire Rapids machines we run on, the
+    /// track step of the reference case (n = 2) takes about 115 ns against 150 ns
+    /// with AVX2 (`examples/profile_step`, fast phase of the machine).
     Avx512,
 }
 
 impl SimdLevel {
-    /// The widest level this CPU supports.
+    /// The widest level this CPU supports (AVX2 and AVX-512 need FMA as well).
     pub fn detect() -> Self {
         #[cfg(target_arch = "x86_64")]
         {
+            if !std::arch::is_x86_feature_detected!("fma") {
+                return SimdLevel::Baseline;
+            }
             if std::arch::is_x86_feature_detected!("avx512f") {
                 return SimdLevel::Avx512;
             }
@@ -487,7 +495,7 @@ const GUARD: usize = LANES;
 /// Slices are as long as `zs`, a multiple of [`LANES`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sleepers_body(
+fn sleepers_body<const FMA: bool>(
     rl: &[f64],
     rr: &[f64],
     rlp: &[f64],
@@ -506,17 +514,28 @@ fn sleepers_body(
     let (pl, pr) = (&mut pl[..m], &mut pr[..m]);
     for i in 0..m {
         let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
-        let (lf, lfp) = (c.ls * f, c.ls * fp);
         // Rail over seat, now and one step back: u = Z_rail - (Z_s -/+ l_s/2 phi).
-        let (ul, ur) = (rl[i] - (z - lf), rr[i] - (z + lf));
-        let (upl, upr) = (rlp[i] - (zp - lfp), rrp[i] - (zp + lfp));
-        let fl = c.cp * upl - c.kpc * ul;
-        let fr = c.cp * upr - c.kpc * ur;
+        let (ul, ur) = (
+            rl[i] - madd::<FMA>(-c.ls, f, z),
+            rr[i] - madd::<FMA>(c.ls, f, z),
+        );
+        let (upl, upr) = (
+            rlp[i] - madd::<FMA>(-c.ls, fp, zp),
+            rrp[i] - madd::<FMA>(c.ls, fp, zp),
+        );
+        let fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
+        let fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
         pl[i] = fl;
         pr[i] = fr;
-        zsp[i] = c.zz * z + c.zzp * zp - c.zf * (fl + fr);
-        php[i] = c.pp * f + c.ppp * fp + c.pf * (fl - fr);
+        zsp[i] = madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z));
+        php[i] = madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f));
     }
+}
+
+/// `a b + c`: fused (one rounding) with `FMA`, else a product and a sum.
+#[inline(always)]
+fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
 }
 
 /// One phase block of the rail stencil (3.12): centre nodes `zc`, `tc` with their
@@ -525,7 +544,7 @@ fn sleepers_body(
 /// forces `pad` enter.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn stencil_body<const PAD: bool>(
+fn stencil_body<const PAD: bool, const FMA: bool>(
     zl: &[f64],
     zc: &[f64],
     zr: &[f64],
@@ -543,33 +562,43 @@ fn stencil_body<const PAD: bool>(
     let (zn, tn) = (&mut zn[..m], &mut tn[..m]);
     let pad = if PAD { &pad[..m] } else { &pad[..0] };
     for i in 0..m {
-        let zci = zc[i];
-        let tci = tc[i];
-        // (3.12) with the centre terms gathered: 8 operations per value instead of 10
-        // and 13.
-        let znew = c.zc * zci - zn[i] + c.zz * (zr[i] + zl[i]) - c.zt * (tr[i] - tl[i]);
-        zn[i] = if PAD { znew + c.force * pad[i] } else { znew };
-        tn[i] = c.tc * tci - tn[i] + c.tt * (tr[i] + tl[i]) + c.tz * (zr[i] - zl[i]);
+        // (3.12) with the centre terms gathered: 5 multiply-adds per value.
+        let znew = madd::<FMA>(
+            -c.zt,
+            tr[i] - tl[i],
+            madd::<FMA>(c.zz, zr[i] + zl[i], madd::<FMA>(c.zc, zc[i], -zn[i])),
+        );
+        zn[i] = if PAD {
+            madd::<FMA>(c.force, pad[i], znew)
+        } else {
+            znew
+        };
+        tn[i] = madd::<FMA>(
+            c.tz,
+            zr[i] - zl[i],
+            madd::<FMA>(c.tt, tr[i] + tl[i], madd::<FMA>(c.tc, tc[i], -tn[i])),
+        );
     }
 }
 
-/// Compiles a loop body for each [`Simd`] level and dispatches on the level.
+/// Compiles a loop body, generic over `const FMA: bool`, for each [`SimdLevel`] (fused
+/// at AVX2 and AVX-512, unfused at the baseline) and dispatches on the level.
 macro_rules! simd_kernel {
-    ($name:ident, $body:path, ($($arg:ident : $ty:ty),*)) => {
+    ($name:ident, $body:ident, ($($arg:ident : $ty:ty),*)) => {
         #[allow(clippy::too_many_arguments)]
         #[inline]
         fn $name(simd: SimdLevel, $($arg: $ty),*) {
             #[cfg(target_arch = "x86_64")]
             {
                 #[allow(clippy::too_many_arguments)]
-                #[target_feature(enable = "avx2")]
+                #[target_feature(enable = "avx2,fma")]
                 fn avx2($($arg: $ty),*) {
-                    $body($($arg),*)
+                    $body::<true>($($arg),*)
                 }
                 #[allow(clippy::too_many_arguments)]
-                #[target_feature(enable = "avx512f")]
+                #[target_feature(enable = "avx512f,fma")]
                 fn avx512($($arg: $ty),*) {
-                    $body($($arg),*)
+                    $body::<true>($($arg),*)
                 }
                 match simd {
                     // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
@@ -580,7 +609,7 @@ macro_rules! simd_kernel {
                 }
             }
             let _ = simd;
-            $body($($arg),*)
+            $body::<false>($($arg),*)
         }
     };
 }
@@ -597,7 +626,7 @@ macro_rules! simd_kernel {
 /// One function, so that one dispatch on the SIMD level covers the whole step.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn kernels_body(
+fn kernels_body<const FMA: bool>(
     z: &[f64],
     th: &[f64],
     z_prev: &mut [f64],
@@ -617,7 +646,7 @@ fn kernels_body(
         let (rl, rr) = z[g..g + b].split_at(sp);
         let (rlp, rrp) = z_prev[g..g + b].split_at(sp);
         let (pl, pr) = pad.split_at_mut(sp);
-        sleepers_body(rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s);
+        sleepers_body::<FMA>(rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s);
     }
     for p in 0..n {
         let centre = g + p * b..g + (p + 1) * b;
@@ -635,9 +664,9 @@ fn kernels_body(
         let (tl, tc, tr) = (&th[left], &th[centre.clone()], &th[right]);
         let (zn, tn) = (&mut z_prev[centre.clone()], &mut th_prev[centre]);
         if p == 0 {
-            stencil_body::<true>(zl, zc, zr, tl, tc, tr, zn, tn, pad, c);
+            stencil_body::<true, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, pad, c);
         } else {
-            stencil_body::<false>(zl, zc, zr, tl, tc, tr, zn, tn, &[], c);
+            stencil_body::<false, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, &[], c);
         }
     }
 }
@@ -1299,9 +1328,10 @@ mod tests {
 
     #[test]
     fn simd_levels_and_storage_agree_bit_for_bit() {
-        // Every SIMD level this CPU has gives the same bits, and the phase-blocked
-        // storage gives the same bits as the plain node-order recurrence written out
-        // here (the scheme of the module docs, one node at a time).
+        // Every SIMD level this CPU has gives the same bits as the plain node-order
+        // recurrence written out here (the scheme of the module docs, one node at a
+        // time): fused multiply-adds for AVX2 and AVX-512 (so those two agree bit for
+        // bit), separate products for the baseline. The two roundings agree closely.
         for n in [1usize, 2, 3] {
             let p = seed_track(6, n);
             let dt = 0.9 * p.critical_time_step().0;
@@ -1317,93 +1347,110 @@ mod tests {
                     force: 0.7e5,
                 },
             ];
-            let mut runs = Vec::new();
+            let steps = 3000;
+            let node_order = |fma: bool| {
+                // `a b + c`, fused (the library's correctly rounded `fma`) or not.
+                let madd = |a: f64, b: f64, c: f64| if fma { a.mul_add(b, c) } else { a * b + c };
+                let t = Track::new(p, dt).unwrap();
+                let c = t.c;
+                let nk = t.nodes();
+                let ns = p.spans + 1;
+                let ls = 0.5 * p.rail_seat_distance;
+                let (mut z, mut th) = (vec![0.0; 2 * nk], vec![0.0; 2 * nk]);
+                let (mut zp, mut thp) = (z.clone(), th.clone());
+                let (mut zs, mut ph) = (vec![0.0; ns], vec![0.0; ns]);
+                let (mut zsp, mut php) = (zs.clone(), ph.clone());
+                let mut pad = vec![0.0; 2 * ns];
+                for _ in 0..steps {
+                    for i in 0..ns {
+                        let (zz, f, zq, fq) = (zs[i], ph[i], zsp[i], php[i]);
+                        let mut fl = [0.0; 2];
+                        let s = &c.s;
+                        for (r, sg) in [(0usize, -1.0), (1, 1.0)] {
+                            let k = r * nk + i * n;
+                            // (3.9): F = -k_p u - c_p (u - u_prev) / dt, u = rail over seat.
+                            let u = z[k] - madd(sg * ls, f, zz);
+                            let u_prev = zp[k] - madd(sg * ls, fq, zq);
+                            fl[r] = madd(-s.kpc, u, s.cp * u_prev);
+                            pad[r * ns + i] = fl[r];
+                        }
+                        zsp[i] = madd(-s.zf, fl[0] + fl[1], madd(s.zzp, zq, s.zz * zz));
+                        php[i] = madd(s.pf, fl[0] - fl[1], madd(s.ppp, fq, s.pp * f));
+                    }
+                    for g in 1..2 * nk - 1 {
+                        let (zc, tc) = (z[g], th[g]);
+                        let zn = madd(c.zz, z[g + 1] + z[g - 1], madd(c.zc, zc, -zp[g]));
+                        zp[g] = madd(-c.zt, th[g + 1] - th[g - 1], zn);
+                        let tn = madd(c.tt, th[g + 1] + th[g - 1], madd(c.tc, tc, -thp[g]));
+                        thp[g] = madd(c.tz, z[g + 1] - z[g - 1], tn);
+                    }
+                    for r in 0..2 {
+                        for i in 0..ns {
+                            zp[r * nk + i * n] = madd(c.force, pad[r * ns + i], zp[r * nk + i * n]);
+                        }
+                    }
+                    for l in &loads {
+                        let (k, w) = t.locate(l.position);
+                        zp[l.rail * nk + k] -= c.force * (1.0 - w) * l.force;
+                        zp[l.rail * nk + k + 1] -= c.force * w * l.force;
+                    }
+                    for e in [0, nk - 1, nk, 2 * nk - 1] {
+                        zp[e] = 0.0;
+                        thp[e] = 0.0;
+                    }
+                    std::mem::swap(&mut z, &mut zp);
+                    std::mem::swap(&mut th, &mut thp);
+                    std::mem::swap(&mut zs, &mut zsp);
+                    std::mem::swap(&mut ph, &mut php);
+                }
+                let mut want = vec![dt];
+                for a in [&z, &th, &zp, &thp, &zs, &ph, &zsp, &php, &pad] {
+                    want.extend_from_slice(a);
+                }
+                want
+            };
+            let (unfused, fused) = (node_order(false), node_order(true));
             for level in SimdLevel::available() {
                 let mut t = Track::new(p, dt).unwrap();
                 t.set_simd(level).unwrap();
-                for _ in 0..3000 {
+                for _ in 0..steps {
                     t.step(&loads);
                 }
-                runs.push(t.state_vector());
-            }
-            for r in &runs[1..] {
+                let got = t.state_vector();
+                let want = if level > SimdLevel::Baseline {
+                    &fused
+                } else {
+                    &unfused
+                };
+                assert_eq!(want.len(), got.len());
+                let first = want
+                    .iter()
+                    .zip(&got)
+                    .position(|(a, b)| a.to_bits() != b.to_bits());
                 assert!(
-                    r.iter()
-                        .zip(&runs[0])
-                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                    first.is_none(),
+                    "n = {n}, {level:?}: phase-blocked storage differs from node order at {first:?} of {}",
+                    want.len()
                 );
             }
-            // Node-order reference.
-            let t = Track::new(p, dt).unwrap();
-            let c = t.c;
-            let nk = t.nodes();
-            let ns = p.spans + 1;
-            let ls = 0.5 * p.rail_seat_distance;
-            let (mut z, mut th) = (vec![0.0; 2 * nk], vec![0.0; 2 * nk]);
-            let (mut zp, mut thp) = (z.clone(), th.clone());
-            let (mut zs, mut ph) = (vec![0.0; ns], vec![0.0; ns]);
-            let (mut zsp, mut php) = (zs.clone(), ph.clone());
-            let mut pad = vec![0.0; 2 * ns];
-            for _ in 0..3000 {
-                for i in 0..ns {
-                    let (zz, f, zq, fq) = (zs[i], ph[i], zsp[i], php[i]);
-                    let mut fl = [0.0; 2];
-                    let s = &c.s;
-                    for (r, sg) in [(0usize, -1.0), (1, 1.0)] {
-                        let k = r * nk + i * n;
-                        // (3.9): F = -k_p u - c_p (u - u_prev) / dt, u = rail over seat.
-                        let u = z[k] - (zz + sg * (ls * f));
-                        let u_prev = zp[k] - (zq + sg * (ls * fq));
-                        fl[r] = s.cp * u_prev - s.kpc * u;
-                        pad[r * ns + i] = fl[r];
-                    }
-                    zsp[i] = s.zz * zz + s.zzp * zq - s.zf * (fl[0] + fl[1]);
-                    php[i] = s.pp * f + s.ppp * fq + s.pf * (fl[0] - fl[1]);
-                }
-                for g in 1..2 * nk - 1 {
-                    let (zc, tc) = (z[g], th[g]);
-                    zp[g] = c.zc * zc - zp[g] + c.zz * (z[g + 1] + z[g - 1])
-                        - c.zt * (th[g + 1] - th[g - 1]);
-                    thp[g] = c.tc * tc - thp[g]
-                        + c.tt * (th[g + 1] + th[g - 1])
-                        + c.tz * (z[g + 1] - z[g - 1]);
-                }
-                for r in 0..2 {
-                    for i in 0..ns {
-                        zp[r * nk + i * n] += c.force * pad[r * ns + i];
-                    }
-                }
-                for l in &loads {
-                    let (k, w) = t.locate(l.position);
-                    zp[l.rail * nk + k] -= c.force * (1.0 - w) * l.force;
-                    zp[l.rail * nk + k + 1] -= c.force * w * l.force;
-                }
-                for e in [0, nk - 1, nk, 2 * nk - 1] {
-                    zp[e] = 0.0;
-                    thp[e] = 0.0;
-                }
-                std::mem::swap(&mut z, &mut zp);
-                std::mem::swap(&mut th, &mut thp);
-                std::mem::swap(&mut zs, &mut zsp);
-                std::mem::swap(&mut ph, &mut php);
-            }
-            let mut want = vec![dt];
-            for a in [&z, &th, &zp, &thp, &zs, &ph, &zsp, &php, &pad] {
-                want.extend_from_slice(a);
-            }
-            assert_eq!(want.len(), runs[0].len());
-            let same = want
+            // The two roundings: the rail deflection under the load agrees to 1e-12
+            // of its size (rounding differences stay at rounding level).
+            let nk = Track::new(p, dt).unwrap().nodes();
+            let scale = unfused[1..1 + 2 * nk]
                 .iter()
-                .zip(&runs[0])
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-            let first = want
+                .fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(scale > 1e-5, "the load must deflect the rail: {scale}");
+            let worst = unfused[1..1 + 2 * nk]
                 .iter()
-                .zip(&runs[0])
-                .position(|(a, b)| a.to_bits() != b.to_bits());
+                .zip(&fused[1..1 + 2 * nk])
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
             assert!(
-                same,
-                "n = {n}: phase-blocked storage differs from node order at {first:?} of {}",
-                want.len()
+                worst < 1e-12 * scale,
+                "fused and unfused differ by {worst:e} of {scale:e}"
+            );
+            assert!(
+                worst > 0.0,
+                "the fused recurrence must differ from the unfused one"
             );
         }
     }
