@@ -12,7 +12,9 @@
 //! asymmetric and split patches are all exact to quadrature accuracy.
 
 use crate::error::{Result, out_of_range, positive};
-use crate::profile::{MAX_FLATS, WheelProfile, cos_small, wrap_angle};
+use crate::profile::{
+    LANES, MAX_FLATS, SMALL_ANGLE, WheelProfile, cos_poly, cos_small, wrap_angle,
+};
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.
@@ -162,7 +164,7 @@ pub fn perfect_wheel_force(kw: f64, radius: f64, delta: f64) -> f64 {
 }
 
 /// Number of Gauss-Legendre points per contact interval.
-const GAUSS_POINTS: usize = 8;
+const GAUSS_POINTS: usize = LANES;
 /// Samples per flat-covered piece used to bracket sign changes. Crossings that fall
 /// between two samples of the same sign are found through the curvature bound (see
 /// [`positive_point`]), so the count trades speed, not exactness: 4, 6, 8 and 12 all
@@ -333,8 +335,61 @@ fn adaptive(
 /// `delta` (m) (or always, with `force_numeric`). `near`: those flats, as (centre
 /// space angle, index in the wheel's flats); their windows lie within `pi` of the
 /// patch, so a space angle `x` sits at `x - centre` from a flat's centre, unwrapped.
+///
+/// Compiled once per instruction set (AVX-512, AVX2, baseline) and dispatched here:
+/// the integrand is evaluated [`LANES`] points at a time where it can be, and those
+/// evaluations vectorise. No FMA at any level, so every level gives the same bits.
 #[inline(never)]
 fn adaptive_flats(
+    kw: f64,
+    wheel: &WheelProfile,
+    near: &[(f64, usize)],
+    overlap: f64,
+    delta: f64,
+    aw: f64,
+    force_numeric: bool,
+) -> ContactState {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f")]
+        fn avx512(
+            kw: f64,
+            wheel: &WheelProfile,
+            near: &[(f64, usize)],
+            overlap: f64,
+            delta: f64,
+            aw: f64,
+            force_numeric: bool,
+        ) -> ContactState {
+            adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
+        }
+        #[target_feature(enable = "avx2")]
+        fn avx2(
+            kw: f64,
+            wheel: &WheelProfile,
+            near: &[(f64, usize)],
+            overlap: f64,
+            delta: f64,
+            aw: f64,
+            force_numeric: bool,
+        ) -> ContactState {
+            adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
+        }
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has just been found to support AVX-512F.
+            return unsafe { avx512(kw, wheel, near, overlap, delta, aw, force_numeric) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has just been found to support AVX2.
+            return unsafe { avx2(kw, wheel, near, overlap, delta, aw, force_numeric) };
+        }
+    }
+    adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
+}
+
+/// [`adaptive_flats`], inlined into each instruction set's copy.
+#[inline(always)]
+fn adaptive_flats_body(
     kw: f64,
     wheel: &WheelProfile,
     near: &[(f64, usize)],
@@ -346,17 +401,45 @@ fn adaptive_flats(
     let rw = wheel.radius;
     let h = rw - delta;
     let flats = wheel.flats();
-    let reduction_of = |j: usize, x: f64| {
-        let (c, i) = near[j];
-        flats[i].reduction(x - c)
-    };
-    let g = |x: f64| {
-        let mut f = 0.0f64;
-        for j in 0..near.len() {
-            f = f.max(reduction_of(j, x));
-        }
-        (rw - f) * cos_small(x) - h
-    };
+    // The closures are marked `#[inline(always)]` (through `inlined`, as attributes on
+    // closures are allowed only in argument position) so that they are compiled into
+    // each instruction set's copy of this function, not once for the baseline.
+    let reduction_of = inlined(
+        #[inline(always)]
+        |j: usize, x: f64| {
+            let (c, i) = near[j];
+            flats[i].reduction(x - c)
+        },
+    );
+    let g = inlined(
+        #[inline(always)]
+        |x: f64| {
+            let mut f = 0.0f64;
+            for j in 0..near.len() {
+                f = f.max(reduction_of(j, x));
+            }
+            (rw - f) * cos_small(x) - h
+        },
+    );
+    // `g` at LANES points at once, vectorised, the same bits as `g` point by point.
+    let g_lanes = inlined(
+        #[inline(always)]
+        |xs: &[f64; LANES]| -> [f64; LANES] {
+            let mut f = [0.0f64; LANES];
+            let mut small = xs.iter().fold(true, |ok, x| ok & (x.abs() <= SMALL_ANGLE));
+            for &(c, i) in near {
+                match flats[i].reduction_lanes(&xs.map(|x| x - c)) {
+                    Some(r) => (0..LANES).for_each(|l| f[l] = f[l].max(r[l])),
+                    None => small = false,
+                }
+            }
+            if small {
+                std::array::from_fn(|l| (rw - f[l]) * cos_poly(xs[l]) - h)
+            } else {
+                xs.map(g)
+            }
+        },
+    );
     let covered = |x: f64| {
         near.iter()
             .any(|&(c, i)| (x - c).abs() < flats[i].half_angle)
@@ -427,35 +510,54 @@ fn adaptive_flats(
         let mut nn = 1;
         let mut roots = [0.0f64; 4 * BRACKET_SAMPLES + 4];
         let mut nr = 0;
-        let mut top0 = dominant(a);
-        for s in 1..=m {
-            let x1 = if s == m {
-                b
-            } else {
-                a + (b - a) * s as f64 / m as f64
-            };
-            let top1 = dominant(x1);
-            if let (Some(i), Some(j)) = (top0, top1)
-                && i != j
-            {
-                let d = |x: f64| reduction_of(i, x) - reduction_of(j, x);
-                let (x0, x1) = (xs[nn - 1], x1);
-                let xc = refine_root(&d, x0, d(x0), x1, d(x1));
-                roots[nr] = xc;
-                nr += 1;
-                xs[nn] = xc;
-                gs[nn] = g(xc);
+        if !several {
+            // One flat: no hand-over points; the samples at once.
+            let x1: [f64; BRACKET_SAMPLES] = std::array::from_fn(|k| {
+                let s = k + 1;
+                if s == m {
+                    b
+                } else {
+                    a + (b - a) * s as f64 / m as f64
+                }
+            });
+            let g1 = g_lanes(&x1);
+            xs[1..=m].copy_from_slice(&x1);
+            gs[1..=m].copy_from_slice(&g1);
+            nn = m + 1;
+        } else {
+            let mut top0 = dominant(a);
+            for s in 1..=m {
+                let x1 = if s == m {
+                    b
+                } else {
+                    a + (b - a) * s as f64 / m as f64
+                };
+                let top1 = dominant(x1);
+                if let (Some(i), Some(j)) = (top0, top1)
+                    && i != j
+                {
+                    let d = |x: f64| reduction_of(i, x) - reduction_of(j, x);
+                    let (x0, x1) = (xs[nn - 1], x1);
+                    let xc = refine_root(&d, x0, d(x0), x1, d(x1));
+                    roots[nr] = xc;
+                    nr += 1;
+                    xs[nn] = xc;
+                    gs[nn] = g(xc);
+                    nn += 1;
+                }
+                xs[nn] = x1;
+                gs[nn] = g(x1);
                 nn += 1;
+                top0 = top1;
             }
-            xs[nn] = x1;
-            gs[nn] = g(x1);
-            nn += 1;
-            top0 = top1;
         }
         // Between two samples: a sign change is a contact end. Two non-positive ends
         // may still hide a sliver of contact, two positive ends a gap, where the
         // curvature bound lets g cross zero in between; these are searched for.
-        let neg_g = |x: f64| -g(x);
+        let neg_g = inlined(
+            #[inline(always)]
+            |x: f64| -g(x),
+        );
         for k in 0..nn - 1 {
             let (g0, g1) = (gs[k], gs[k + 1]);
             let d = xs[k + 1] - xs[k];
@@ -512,7 +614,7 @@ fn adaptive_flats(
                 // R = R_w here: integral of R_w cos(alpha) - h, written without cancellation.
                 rw * (sin_minus_x(b) - sin_minus_x(a)) + delta * (b - a)
             } else {
-                gauss(&g, a, b)
+                gauss(&g_lanes, a, b)
             };
             if !in_contact {
                 intervals += 1;
@@ -540,6 +642,12 @@ fn adaptive_flats(
     }
 }
 
+/// `f` itself: lets a closure be marked `#[inline(always)]` where it is defined.
+#[inline(always)]
+fn inlined<F>(f: F) -> F {
+    f
+}
+
 /// Rounding allowance (m) in the curvature test for slivers: far above the rounding
 /// of one evaluation of the integrand (about 1e-16 R_w).
 const ROUNDING: f64 = 1e-15;
@@ -549,6 +657,7 @@ const MAX_BREAKS: usize = 4 * MAX_FLATS + 2 * BRACKET_SAMPLES + 8;
 
 /// Root of `g` in `[lo, hi]` (where `g` changes sign; `glo`, `ghi` its values there)
 /// by the Illinois variant of regula falsi (superlinear), ended at 1e-15 rad.
+#[inline(always)]
 fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, glo: f64, hi: f64, ghi: f64) -> f64 {
     let (mut a, mut b) = (lo, hi);
     let (mut fa, mut fb) = (glo, ghi);
@@ -594,6 +703,7 @@ fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, glo: f64, hi: f64, ghi: f64) -
 /// curvature bound (`g` rises at most `rise w^2` above the larger end value of an
 /// interval `w` wide) show that `g` stays non-positive, or the interval is below
 /// 1e-13 rad. `glo`, `ghi`: `g` at the ends.
+#[inline(always)]
 fn positive_point<G: Fn(f64) -> f64>(
     g: &G,
     lo: f64,
@@ -637,6 +747,7 @@ fn positive_point<G: Fn(f64) -> f64>(
 /// (`glo`, `ghi`), or `None` when `g` stays non-positive there (see
 /// [`positive_point`]). Each end is bracketed between the positive point found and
 /// the nearer end of the interval.
+#[inline(always)]
 fn sliver<G: Fn(f64) -> f64>(
     g: &G,
     lo: f64,
@@ -652,16 +763,20 @@ fn sliver<G: Fn(f64) -> f64>(
     ))
 }
 
-fn gauss<G: Fn(f64) -> f64>(g: &G, a: f64, b: f64) -> f64 {
+/// Gauss-Legendre integral of `max(g, 0)` over `[a, b]`, `g_lanes` evaluating `g` at
+/// all points at once.
+#[inline(always)]
+fn gauss<G: Fn(&[f64; LANES]) -> [f64; LANES]>(g_lanes: &G, a: f64, b: f64) -> f64 {
     if b <= a {
         return 0.0;
     }
     let (x, w) = gauss_legendre();
     let c = 0.5 * (a + b);
     let r = 0.5 * (b - a);
+    let gx = g_lanes(&std::array::from_fn(|i| c + r * x[i]));
     let mut s = 0.0;
     for i in 0..GAUSS_POINTS {
-        s += w[i] * g(c + r * x[i]).max(0.0);
+        s += w[i] * gx[i].max(0.0);
     }
     s * r
 }

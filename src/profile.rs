@@ -31,14 +31,23 @@ pub fn wrap_angle(a: f64) -> f64 {
 /// integrand of (2.8) takes the polynomial.
 #[inline]
 pub fn cos_small(a: f64) -> f64 {
-    if a.abs() <= 0.2 {
-        let x = a * a;
-        let (x2, c) = (x * x, &COS_TAYLOR);
-        // Estrin's scheme: (c0 + c1 x) + x^2 (c2 + c3 x) + x^4 (c4 + c5 x).
-        (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2 + (c[4] + c[5] * x) * (x2 * x2)
+    if a.abs() <= SMALL_ANGLE {
+        cos_poly(a)
     } else {
         a.cos()
     }
+}
+
+/// Largest angle (rad) for which [`cos_small`] and [`tan_small`] use their polynomials.
+pub(crate) const SMALL_ANGLE: f64 = 0.2;
+
+/// The polynomial of [`cos_small`], whatever `a` (valid for `|a| <=` [`SMALL_ANGLE`]).
+#[inline(always)]
+pub(crate) fn cos_poly(a: f64) -> f64 {
+    let x = a * a;
+    let (x2, c) = (x * x, &COS_TAYLOR);
+    // Estrin's scheme: (c0 + c1 x) + x^2 (c2 + c3 x) + x^4 (c4 + c5 x).
+    (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2 + (c[4] + c[5] * x) * (x2 * x2)
 }
 
 /// `tan a`: its Taylor polynomial to `a^19` for `|a| <= 0.2` rad (the first omitted
@@ -46,18 +55,24 @@ pub fn cos_small(a: f64) -> f64 {
 /// dependency chain of five multiply-adds. The library tangent otherwise.
 #[inline]
 pub fn tan_small(a: f64) -> f64 {
-    if a.abs() <= 0.2 {
-        let x = a * a;
-        let c = &TAN_TAYLOR;
-        let x2 = x * x;
-        let x4 = x2 * x2;
-        let p03 = (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2;
-        let p47 = (c[4] + c[5] * x) + (c[6] + c[7] * x) * x2;
-        let p89 = c[8] + c[9] * x;
-        a * ((p03 + p47 * x4) + p89 * (x4 * x4))
+    if a.abs() <= SMALL_ANGLE {
+        tan_poly(a)
     } else {
         a.tan()
     }
+}
+
+/// The polynomial of [`tan_small`], whatever `a` (valid for `|a| <=` [`SMALL_ANGLE`]).
+#[inline(always)]
+fn tan_poly(a: f64) -> f64 {
+    let x = a * a;
+    let c = &TAN_TAYLOR;
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let p03 = (c[0] + c[1] * x) + (c[2] + c[3] * x) * x2;
+    let p47 = (c[4] + c[5] * x) + (c[6] + c[7] * x) * x2;
+    let p89 = c[8] + c[9] * x;
+    a * ((p03 + p47 * x4) + p89 * (x4 * x4))
 }
 
 /// The tangent's Taylor coefficients (over `a`) in `a^2`,
@@ -109,6 +124,9 @@ const COS_TAYLOR: [f64; 11] = [
     -1.0 / 6402373705728000.0,
     1.0 / 2432902008176640000.0,
 ];
+
+/// Angles evaluated together by [`Flat::reduction_lanes`]: one AVX-512 vector.
+pub(crate) const LANES: usize = 8;
 
 /// Shape of a flat.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -186,18 +204,47 @@ impl Flat {
             return 0.0;
         }
         match self.shape {
-            FlatShape::Haversine => {
-                // (2.16) with x = l_f/2 + (R_w - D_f) tan psi along the flat:
-                // D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l) = D cos^2 u with
-                // u = pi x / l - pi/2 = k_tan tan psi. u is clamped to [-pi/2, pi/2]
-                // (x to [0, l_f]) so that the profile is continuous at the flat ends
-                // (the seed's x misses 0 by ~1e-5 l_f).
-                let u = (self.k_tan * tan_small(psi)).clamp(-0.5 * PI, 0.5 * PI);
-                let s = cos_half_pi(u);
-                self.depth * s * s
-            }
-            FlatShape::Chord => self.radius - (self.radius - self.depth) / cos_small(psi),
+            FlatShape::Haversine => self.haversine_of_tan(tan_small(psi)),
+            FlatShape::Chord => self.chord_of_cos(cos_small(psi)),
         }
+    }
+
+    /// (2.16) with x = l_f/2 + (R_w - D_f) tan psi along the flat, from `tan psi`:
+    /// D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l) = D cos^2 u with
+    /// u = pi x / l - pi/2 = k_tan tan psi. u is clamped to [-pi/2, pi/2]
+    /// (x to [0, l_f]) so that the profile is continuous at the flat ends
+    /// (the seed's x misses 0 by ~1e-5 l_f).
+    #[inline(always)]
+    fn haversine_of_tan(&self, tan_psi: f64) -> f64 {
+        let u = (self.k_tan * tan_psi).clamp(-0.5 * PI, 0.5 * PI);
+        let s = cos_half_pi(u);
+        self.depth * s * s
+    }
+
+    /// (2.12) from `cos psi`.
+    #[inline(always)]
+    fn chord_of_cos(&self, cos_psi: f64) -> f64 {
+        self.radius - (self.radius - self.depth) / cos_psi
+    }
+
+    /// [`Flat::reduction`] at [`LANES`] angles at once, written so that the compiler
+    /// vectorises it: every lane computes exactly what [`Flat::reduction`] computes,
+    /// so the results are the same bits. `None` when a lane inside the flat lies
+    /// beyond [`SMALL_ANGLE`] (where [`Flat::reduction`] calls the library functions).
+    #[inline(always)]
+    pub(crate) fn reduction_lanes(&self, psi: &[f64; LANES]) -> Option<[f64; LANES]> {
+        let mut out = [0.0; LANES];
+        let mut small = true;
+        for l in 0..LANES {
+            let (p, inside) = (psi[l], psi[l].abs() < self.half_angle);
+            small &= !inside || p.abs() <= SMALL_ANGLE;
+            let r = match self.shape {
+                FlatShape::Haversine => self.haversine_of_tan(tan_poly(p)),
+                FlatShape::Chord => self.chord_of_cos(cos_poly(p)),
+            };
+            out[l] = if inside { r } else { 0.0 };
+        }
+        small.then_some(out)
     }
 
     /// Radius reduction (m) at space angle `alpha` (rad) for axle rotation `gamma` (rad).
@@ -412,6 +459,62 @@ mod tests {
         assert_eq!(w.reduction(0.3 + phi * 1.01, 0.0), 0.0);
         // Profile is continuous at both ends (clamping of x).
         assert!(w.reduction(0.3 - phi + 1e-12, 0.0) < 1e-12);
+    }
+
+    #[test]
+    fn reduction_lanes_give_the_same_bits_as_reduction() {
+        // Haversine and chord flats, angles inside, at the edge of and outside the flat:
+        // every lane equals the one-angle evaluation bit for bit; a lane inside the
+        // flat beyond SMALL_ANGLE (library functions there) refuses the batch.
+        let flats = [
+            FlatSpec::haversine(0.1, 0.0015, 0.0),
+            FlatSpec::chord(0.08, 0.0),
+            FlatSpec::haversine(0.3, 0.004, 0.0),
+        ];
+        let w = WheelProfile::new(R, &flats, "flat.left").unwrap();
+        for fl in w.flats() {
+            let h = fl.half_angle;
+            for k in 0..200 {
+                let psi: [f64; LANES] = std::array::from_fn(|l| {
+                    (k as f64 * 0.37 + l as f64 * 0.93).sin() * (1.3 * h).min(SMALL_ANGLE)
+                });
+                let want = psi.map(|p| fl.reduction(p));
+                let got = fl
+                    .reduction_lanes(&psi)
+                    .expect("all lanes within SMALL_ANGLE");
+                for l in 0..LANES {
+                    assert_eq!(
+                        got[l].to_bits(),
+                        want[l].to_bits(),
+                        "{:?} psi {}",
+                        fl.shape,
+                        psi[l]
+                    );
+                }
+                assert!(want.iter().any(|&f| f > 0.0));
+            }
+            if h > SMALL_ANGLE {
+                continue;
+            }
+            let mut edge = [0.0; LANES];
+            edge[0] = h;
+            edge[1] = -h;
+            edge[2] = h * (1.0 - 1e-15);
+            let got = fl.reduction_lanes(&edge).unwrap();
+            assert_eq!(
+                got.map(f64::to_bits),
+                edge.map(|p| fl.reduction(p).to_bits())
+            );
+        }
+        // The 300 mm flat reaches beyond SMALL_ANGLE (half angle 0.316 rad).
+        let wide = &w.flats()[2];
+        assert!(wide.half_angle > SMALL_ANGLE);
+        let mut psi = [0.0; LANES];
+        psi[3] = 0.25;
+        assert_eq!(wide.reduction_lanes(&psi), None);
+        // ... but outside a flat a large angle needs no library function.
+        psi[3] = 0.5;
+        assert!(wide.reduction_lanes(&psi).is_some());
     }
 
     #[test]

@@ -623,7 +623,7 @@ macro_rules! simd_kernel {
 ///    block p - 1 (block n - 1 one slot back for p = 0), its right neighbours block
 ///    p + 1 (block 0 one slot on for p = n - 1).
 ///
-/// One function, so that one dispatch on the SIMD level covers the whole step.
+/// Inlined into [`step_body`], which is compiled once per SIMD level.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn kernels_body<const FMA: bool>(
@@ -671,10 +671,78 @@ fn kernels_body<const FMA: bool>(
     }
 }
 
-simd_kernel!(kernels, kernels_body, (
-    z: &[f64], th: &[f64], z_prev: &mut [f64], th_prev: &mut [f64], zs: &[f64], ph: &[f64],
-    zs_prev: &mut [f64], ph_prev: &mut [f64], pad: &mut [f64], c: &Coeffs, n: usize
-));
+/// [`Track::step`]: the loops of [`kernels_body`], then the wheel forces, end
+/// conditions and padding. The whole step is one function per [`SimdLevel`], so that
+/// the call passes two pointers and the glue is compiled for the level too.
+#[inline(always)]
+fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
+    let (inv_dx, nk) = (t.inv_dx, t.nk);
+    let Track {
+        params,
+        c,
+        sp,
+        z,
+        th,
+        z_prev,
+        th_prev,
+        zs,
+        ph,
+        zs_prev,
+        ph_prev,
+        pad,
+        padding,
+        ends_inner,
+        slot,
+        ..
+    } = t;
+    let sp = *sp;
+    let n = params.nodes_per_span;
+    // The stencil overwrites every slot; pinned ends need their t_(j-1) rotation.
+    let th_prev_ends = match params.ends {
+        RailEnds::Pinned => ends_inner.map(|(e, _)| th_prev[e]),
+        RailEnds::Fixed => [0.0; 4],
+    };
+    // 1-2. Sleepers and pads, then the rail stencil (see `kernels_body`).
+    kernels_body::<FMA>(z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, c, n);
+    // 3. Wheel forces on the new rail state; end conditions; padding.
+    for l in loads {
+        let (k, w) = locate(l.position, inv_dx, nk);
+        let r = l.rail.min(1) * sp;
+        z_prev[slot[k] + r] -= c.force * (1.0 - w) * l.force;
+        z_prev[slot[k + 1] + r] -= c.force * w * l.force;
+    }
+    for &s in padding.iter() {
+        z_prev[s] = 0.0;
+        th_prev[s] = 0.0;
+    }
+    for &(e, _) in ends_inner.iter() {
+        z_prev[e] = 0.0;
+    }
+    match params.ends {
+        RailEnds::Fixed => {
+            for &(e, _) in ends_inner.iter() {
+                th_prev[e] = 0.0;
+            }
+        }
+        RailEnds::Pinned => {
+            // Ghost nodes: Z odd, theta even about the support.
+            for (e, &(end, inner)) in ends_inner.iter().enumerate() {
+                let sgn = if e % 2 == 0 { 1.0 } else { -1.0 };
+                let (t0, ti, zi) = (th[end], th[inner], z[inner]);
+                th_prev[end] = 2.0 * t0 - th_prev_ends[e]
+                    + c.tt * (2.0 * ti - 2.0 * t0)
+                    + sgn * c.tz * 2.0 * zi
+                    - c.t0 * t0;
+            }
+        }
+    }
+    std::mem::swap(z, z_prev);
+    std::mem::swap(th, th_prev);
+    std::mem::swap(zs, zs_prev);
+    std::mem::swap(ph, ph_prev);
+}
+
+simd_kernel!(track_step, step_body, (t: &mut Track, loads: &[PointLoad]));
 
 impl Track {
     /// A track at rest and undeformed, stepped with `dt` (s). Refuses a step above
@@ -868,75 +936,9 @@ impl Track {
     }
 
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
-    #[inline(always)]
+    #[inline]
     pub fn step(&mut self, loads: &[PointLoad]) {
-        let (inv_dx, nk) = (self.inv_dx, self.nk);
-        let Track {
-            params,
-            c,
-            sp,
-            z,
-            th,
-            z_prev,
-            th_prev,
-            zs,
-            ph,
-            zs_prev,
-            ph_prev,
-            pad,
-            padding,
-            ends_inner,
-            slot,
-            simd,
-            ..
-        } = self;
-        let (sp, simd) = (*sp, *simd);
-        let n = params.nodes_per_span;
-        // The stencil overwrites every slot; pinned ends need their t_(j-1) rotation.
-        let th_prev_ends = match params.ends {
-            RailEnds::Pinned => ends_inner.map(|(e, _)| th_prev[e]),
-            RailEnds::Fixed => [0.0; 4],
-        };
-        // 1-2. Sleepers and pads, then the rail stencil (see `kernels_body`).
-        kernels(
-            simd, z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, c, n,
-        );
-        // 3. Wheel forces on the new rail state; end conditions; padding.
-        for l in loads {
-            let (k, w) = locate(l.position, inv_dx, nk);
-            let r = l.rail.min(1) * sp;
-            z_prev[slot[k] + r] -= c.force * (1.0 - w) * l.force;
-            z_prev[slot[k + 1] + r] -= c.force * w * l.force;
-        }
-        for &s in padding.iter() {
-            z_prev[s] = 0.0;
-            th_prev[s] = 0.0;
-        }
-        for &(e, _) in ends_inner.iter() {
-            z_prev[e] = 0.0;
-        }
-        match params.ends {
-            RailEnds::Fixed => {
-                for &(e, _) in ends_inner.iter() {
-                    th_prev[e] = 0.0;
-                }
-            }
-            RailEnds::Pinned => {
-                // Ghost nodes: Z odd, theta even about the support.
-                for (e, &(end, inner)) in ends_inner.iter().enumerate() {
-                    let sgn = if e % 2 == 0 { 1.0 } else { -1.0 };
-                    let (t0, ti, zi) = (th[end], th[inner], z[inner]);
-                    th_prev[end] = 2.0 * t0 - th_prev_ends[e]
-                        + c.tt * (2.0 * ti - 2.0 * t0)
-                        + sgn * c.tz * 2.0 * zi
-                        - c.t0 * t0;
-                }
-            }
-        }
-        std::mem::swap(z, z_prev);
-        std::mem::swap(th, th_prev);
-        std::mem::swap(zs, zs_prev);
-        std::mem::swap(ph, ph_prev);
+        track_step(self.simd, self, loads);
     }
 
     /// Number of unknowns of the static problem.
