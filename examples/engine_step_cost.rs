@@ -1,7 +1,8 @@
 //! Cost of the reference case (table 4.4, 70 km/h, one 100 mm x 1.5 mm flat,
 //! 30 spans) at the seed grid (n = 2, dt = 45 us), for instruction counting:
 //! `valgrind --tool=callgrind target/release/examples/engine_step_cost [seconds [repeats]]`.
-//! Without valgrind it prints wall time per step and per simulated second.
+//! Without valgrind it prints wall time per step and per simulated second. A third
+//! argument `baseline`, `avx2` or `avx512` picks the SIMD level (default: the widest).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -16,7 +17,17 @@ fn main() {
     let mut s = Scenario::table_4_4_flat();
     s.set_nodes_per_span(2);
     s.dt = 45e-6;
-    let sim = Simulation::new(&s).unwrap();
+    let mut sim = Simulation::new(&s).unwrap();
+    if let Some(level) = std::env::args().nth(3) {
+        use wheelflat::track::SimdLevel;
+        let level = match level.as_str() {
+            "baseline" => SimdLevel::Baseline,
+            "avx2" => SimdLevel::Avx2,
+            "avx512" => SimdLevel::Avx512,
+            other => panic!("unknown SIMD level {other}: baseline, avx2 or avx512"),
+        };
+        sim.set_simd(level).unwrap();
+    }
     let repeats: u64 = std::env::args()
         .nth(2)
         .and_then(|s| s.parse().ok())
