@@ -15,6 +15,7 @@ use crate::error::{Result, out_of_range, positive};
 use crate::profile::{
     LANES, MAX_FLATS, SMALL_ANGLE, WheelProfile, cos_poly, cos_small, wrap_angle,
 };
+use crate::track::SimdLevel;
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.
@@ -336,7 +337,8 @@ fn adaptive(
 /// space angle, index in the wheel's flats); their windows lie within `pi` of the
 /// patch, so a space angle `x` sits at `x - centre` from a flat's centre, unwrapped.
 ///
-/// Compiled once per instruction set (AVX-512, AVX2, baseline) and dispatched here:
+/// Compiled once per instruction set (AVX-512, AVX2, baseline: the widest this CPU
+/// has) and dispatched here:
 /// the integrand is evaluated [`LANES`] points at a time where it can be, and those
 /// evaluations vectorise. No FMA at any level, so every level gives the same bits.
 #[inline(never)]
@@ -349,42 +351,10 @@ fn adaptive_flats(
     aw: f64,
     force_numeric: bool,
 ) -> ContactState {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx512f")]
-        fn avx512(
-            kw: f64,
-            wheel: &WheelProfile,
-            near: &[(f64, usize)],
-            overlap: f64,
-            delta: f64,
-            aw: f64,
-            force_numeric: bool,
-        ) -> ContactState {
-            adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
-        }
-        #[target_feature(enable = "avx2")]
-        fn avx2(
-            kw: f64,
-            wheel: &WheelProfile,
-            near: &[(f64, usize)],
-            overlap: f64,
-            delta: f64,
-            aw: f64,
-            force_numeric: bool,
-        ) -> ContactState {
-            adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
-        }
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has just been found to support AVX-512F.
-            return unsafe { avx512(kw, wheel, near, overlap, delta, aw, force_numeric) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has just been found to support AVX2.
-            return unsafe { avx2(kw, wheel, near, overlap, delta, aw, force_numeric) };
-        }
-    }
-    adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric)
+    SimdLevel::detect().run(
+        #[inline(always)]
+        || adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric),
+    )
 }
 
 /// [`adaptive_flats`], inlined into each instruction set's copy.

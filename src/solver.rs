@@ -121,27 +121,13 @@ fn wrap_turns(a: f64) -> f64 {
     if r < 0.0 { r + TAU } else { r }
 }
 
-/// Runs `f` compiled for `level`: with AVX2 or wider, inside a function compiled for
-/// AVX2, into which `f` and everything it calls `#[inline(always)]` are inlined. Mark
-/// the closure `#[inline(always)]` too: otherwise it stays a function of its own,
-/// compiled for the baseline (1,096 instead of 870 instructions in the step).
-/// Nothing in it is contracted into FMA (the track loops it calls are, at AVX2 and
-/// AVX-512: see [`SimdLevel`]).
+/// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]): the coupled
+/// step outside the track loops, which have their own AVX-512 copy, is compiled as for
+/// AVX2 (1,096 instructions baseline, 870 AVX2). Nothing in it is contracted into FMA
+/// (the track loops it calls are, at AVX2 and AVX-512: see [`SimdLevel`]).
 #[inline(always)]
 fn at_level<R>(level: SimdLevel, f: impl FnOnce() -> R) -> R {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx2")]
-        fn avx2<R>(f: impl FnOnce() -> R) -> R {
-            f()
-        }
-        if level >= SimdLevel::Avx2 {
-            // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
-            // `Simulation::set_simd`).
-            return unsafe { avx2(f) };
-        }
-    }
-    f()
+    level.min(SimdLevel::Avx2).run(f)
 }
 
 /// Time step used when the scenario asks for the default (`dt = 0`) (s).

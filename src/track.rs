@@ -367,6 +367,34 @@ impl SimdLevel {
         SimdLevel::Baseline
     }
 
+    /// Runs `f` compiled for this level: inside a function compiled for AVX-512F or
+    /// AVX2 (with FMA), into which `f` and everything it calls `#[inline(always)]` are
+    /// inlined. Mark the closure `#[inline(always)]` too: otherwise it stays a
+    /// function of its own, compiled for the baseline. Nothing is contracted into FMA
+    /// by this; only explicit `mul_add`s fuse.
+    #[inline(always)]
+    pub(crate) fn run<R>(self, f: impl FnOnce() -> R) -> R {
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx512f,fma")]
+            fn avx512<R>(f: impl FnOnce() -> R) -> R {
+                f()
+            }
+            #[target_feature(enable = "avx2,fma")]
+            fn avx2<R>(f: impl FnOnce() -> R) -> R {
+                f()
+            }
+            match self {
+                // SAFETY: only levels this CPU reports are ever set or detected
+                // (`SimdLevel::detect`, `Track::set_simd`, `Simulation::set_simd`).
+                SimdLevel::Avx512 => return unsafe { avx512(f) },
+                SimdLevel::Avx2 => return unsafe { avx2(f) },
+                SimdLevel::Baseline => {}
+            }
+        }
+        f()
+    }
+
     /// Every level this CPU supports, narrowest first.
     pub fn available() -> Vec<Self> {
         let top = Self::detect();
@@ -425,8 +453,8 @@ impl std::ops::DerefMut for Aligned {
 ///
 /// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
 /// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to
-/// `S`, a multiple of [`LANES`], node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
-/// (`G` = [`LANES`] unused values in front, as many behind; arrays start on a cache line, so every block does too). Block 0 (`k % n = 0`) therefore holds the
+/// `S`, a multiple of `LANES` (8), node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
+/// (`G` = `LANES` unused values in front, as many behind; arrays start on a cache line, so every block does too). Block 0 (`k % n = 0`) therefore holds the
 /// rail nodes above the sleepers, left rail then right rail, in sleeper order, and
 /// the sleeper loop reads it directly; every block is stepped whole, its first and
 /// last neighbours reading the guards. Slots past a rail's last node (one per rail in
@@ -581,39 +609,6 @@ fn stencil_body<const PAD: bool, const FMA: bool>(
     }
 }
 
-/// Compiles a loop body, generic over `const FMA: bool`, for each [`SimdLevel`] (fused
-/// at AVX2 and AVX-512, unfused at the baseline) and dispatches on the level.
-macro_rules! simd_kernel {
-    ($name:ident, $body:ident, ($($arg:ident : $ty:ty),*)) => {
-        #[allow(clippy::too_many_arguments)]
-        #[inline]
-        fn $name(simd: SimdLevel, $($arg: $ty),*) {
-            #[cfg(target_arch = "x86_64")]
-            {
-                #[allow(clippy::too_many_arguments)]
-                #[target_feature(enable = "avx2,fma")]
-                fn avx2($($arg: $ty),*) {
-                    $body::<true>($($arg),*)
-                }
-                #[allow(clippy::too_many_arguments)]
-                #[target_feature(enable = "avx512f,fma")]
-                fn avx512($($arg: $ty),*) {
-                    $body::<true>($($arg),*)
-                }
-                match simd {
-                    // SAFETY: only levels this CPU reports are ever set (`SimdLevel::detect`,
-                    // `Track::set_simd`).
-                    SimdLevel::Avx512 => return unsafe { avx512($($arg),*) },
-                    SimdLevel::Avx2 => return unsafe { avx2($($arg),*) },
-                    SimdLevel::Baseline => {}
-                }
-            }
-            let _ = simd;
-            $body::<false>($($arg),*)
-        }
-    };
-}
-
 /// One track step's loops over phase-blocked arrays of `n` blocks (see [`Track`]):
 /// 1. pad forces at t_j (backward-difference damper velocities) and the sleeper
 ///    update (3.18), in place over the t_(j-1) sleeper arrays; block 0 holds the rail
@@ -672,8 +667,8 @@ fn kernels_body<const FMA: bool>(
 }
 
 /// [`Track::step`]: the loops of [`kernels_body`], then the wheel forces, end
-/// conditions and padding. The whole step is one function per [`SimdLevel`], so that
-/// the call passes two pointers and the glue is compiled for the level too.
+/// conditions and padding; products and sums fused with `FMA`. The whole step is
+/// compiled once per [`SimdLevel`], the glue with the loops.
 #[inline(always)]
 fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     let (inv_dx, nk) = (t.inv_dx, t.nk);
@@ -741,8 +736,6 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     std::mem::swap(zs, zs_prev);
     std::mem::swap(ph, ph_prev);
 }
-
-simd_kernel!(track_step, step_body, (t: &mut Track, loads: &[PointLoad]));
 
 impl Track {
     /// A track at rest and undeformed, stepped with `dt` (s). Refuses a step above
@@ -936,9 +929,16 @@ impl Track {
     }
 
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self, loads: &[PointLoad]) {
-        track_step(self.simd, self, loads);
+        match self.simd {
+            // No hardware FMA assumed at the baseline (the library `fma` is slow).
+            SimdLevel::Baseline => step_body::<false>(self, loads),
+            level => level.run(
+                #[inline(always)]
+                || step_body::<true>(self, loads),
+            ),
+        }
     }
 
     /// Number of unknowns of the static problem.
