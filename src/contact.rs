@@ -626,19 +626,21 @@ const ROUNDING: f64 = 1e-15;
 const MAX_BREAKS: usize = 4 * MAX_FLATS + 2 * BRACKET_SAMPLES + 8;
 
 /// Root of `g` in `[lo, hi]` (where `g` changes sign; `glo`, `ghi` its values there)
-/// by the Illinois variant of regula falsi (superlinear), ended at 1e-15 rad.
+/// by the Anderson-Bjorck variant of regula falsi (order about 1.7; the end kept
+/// twice has its value scaled by `1 - g(c)/g(b)`, or halved as in Illinois when that
+/// is not positive), ended at 1e-15 rad. The bracket `[a, b]` may be reversed; `b`
+/// is always the newest point.
 #[inline(always)]
 fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, glo: f64, hi: f64, ghi: f64) -> f64 {
     let (mut a, mut b) = (lo, hi);
     let (mut fa, mut fb) = (glo, ghi);
-    let mut side = 0i32;
     for _ in 0..100 {
         if (b - a).abs() <= 1e-15 {
             break;
         }
         let denom = fb - fa;
         let mut c = if denom != 0.0 {
-            (a * fb - b * fa) / denom
+            b - fb * (b - a) / denom
         } else {
             0.5 * (a + b)
         };
@@ -649,21 +651,15 @@ fn refine_root<G: Fn(f64) -> f64>(g: &G, lo: f64, glo: f64, hi: f64, ghi: f64) -
         if fc == 0.0 {
             return c;
         }
-        if (fc > 0.0) == (fb > 0.0) {
-            b = c;
-            fb = fc;
-            if side == -1 {
-                fa *= 0.5;
-            }
-            side = -1;
+        if (fc > 0.0) != (fb > 0.0) {
+            // The root lies between b and c: b becomes the kept end.
+            (a, fa) = (b, fb);
         } else {
-            a = c;
-            fa = fc;
-            if side == 1 {
-                fb *= 0.5;
-            }
-            side = 1;
+            // a is kept again: scale its value down.
+            let m = 1.0 - fc / fb;
+            fa *= if m > 0.0 { m } else { 0.5 };
         }
+        (b, fb) = (c, fc);
     }
     0.5 * (a + b)
 }
