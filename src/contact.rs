@@ -480,33 +480,31 @@ fn adaptive_flats_body(
         let mut nn = 1;
         let mut roots = [0.0f64; 4 * BRACKET_SAMPLES + 4];
         let mut nr = 0;
+        // Sample positions after `a`, the last one `b`.
+        let x_samples: [f64; BRACKET_SAMPLES] = std::array::from_fn(|k| {
+            let s = k + 1;
+            if s == m {
+                b
+            } else {
+                a + (b - a) * s as f64 / m as f64
+            }
+        });
         if !several {
             // One flat: no hand-over points; the samples at once.
-            let x1: [f64; BRACKET_SAMPLES] = std::array::from_fn(|k| {
-                let s = k + 1;
-                if s == m {
-                    b
-                } else {
-                    a + (b - a) * s as f64 / m as f64
-                }
-            });
-            let g1 = g_lanes(&x1);
-            xs[1..=m].copy_from_slice(&x1);
-            gs[1..=m].copy_from_slice(&g1);
+            xs[1..=m].copy_from_slice(&x_samples);
+            gs[1..=m].copy_from_slice(&g_lanes(&x_samples));
             nn = m + 1;
         } else {
             let mut top0 = dominant(a);
-            for s in 1..=m {
-                let x1 = if s == m {
-                    b
-                } else {
-                    a + (b - a) * s as f64 / m as f64
-                };
+            for &x1 in &x_samples {
                 let top1 = dominant(x1);
                 if let (Some(i), Some(j)) = (top0, top1)
                     && i != j
                 {
-                    let d = |x: f64| reduction_of(i, x) - reduction_of(j, x);
+                    let d = inlined(
+                        #[inline(always)]
+                        |x: f64| reduction_of(i, x) - reduction_of(j, x),
+                    );
                     let (x0, x1) = (xs[nn - 1], x1);
                     let xc = refine_root(&d, x0, d(x0), x1, d(x1));
                     roots[nr] = xc;
