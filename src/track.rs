@@ -452,15 +452,23 @@ impl std::ops::DerefMut for Aligned {
 /// Track state and its explicit time stepper.
 ///
 /// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
-/// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to
-/// `S`, a multiple of `LANES` (8), node `k` of rail `r` sits at `G + (k % n) 2S + r S + k / n`
-/// (`G` = `LANES` unused values in front, as many behind; arrays start on a cache line, so every block does too). Block 0 (`k % n = 0`) therefore holds the
-/// rail nodes above the sleepers, left rail then right rail, in sleeper order, and
-/// the sleeper loop reads it directly; every block is stepped whole, its first and
-/// last neighbours reading the guards. Slots past a rail's last node (one per rail in
-/// block 0 when `N_s < S`, more in blocks `1..n`, which have `N` nodes) are padding,
-/// set to zero after every step; real nodes never read them, and the padded sleepers,
-/// seeing zero rails, stay at zero. Accessors return node order.
+/// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to `S`, a
+/// multiple of `LANES` (8), phase block `p = k % n` holds node `k` of rail `r` at
+/// `r S + k / n`, and the blocks are stored `1, 2, .., n - 1, 0` after `G = LANES`
+/// unused values (as many behind; arrays start on a cache line, so every block does
+/// too). Block 0 therefore holds the rail nodes above the sleepers, left rail then
+/// right rail, in sleeper order, and the sleeper loop reads it directly. Every block
+/// is stepped whole.
+///
+/// Slots past a rail's last node (one per rail in block 0 when `N_s < S`, more in
+/// blocks `1..n`, which have `N` nodes) are padding. No real node reads a padding
+/// slot, and padding slots read only padding, the rail ends and the guards (this is
+/// why block 0 comes last: the slot one past it, which the last slot of block `n - 1`
+/// reads, is the trailing guard and not node 1 of the left rail). Block 0's stencil
+/// masks its padding and the rail ends to zero, so with fixed ends the padding, the
+/// padded sleepers and their pads start at zero and stay there without a store after
+/// the loops; pinned ends, whose end rotations move, clear the padding after every
+/// step. Accessors return node order.
 #[derive(Debug, Clone)]
 pub struct Track {
     params: TrackParams,
@@ -496,6 +504,9 @@ pub struct Track {
     /// Pad forces on the rails (N): left rail sleepers at `0..N_s`, right rail
     /// sleepers at `S..S + N_s`.
     pad: Aligned,
+    /// Mask of block 0's new values (bit patterns, laid out as the block): all bits
+    /// set over the interior nodes, none over the rail ends and the padding.
+    keep: Aligned,
     simd: SimdLevel,
 }
 
@@ -510,10 +521,20 @@ fn locate(x: f64, inv_dx: f64, nk: usize) -> (usize, f64) {
     (k, (s - k as f64).clamp(0.0, 1.0))
 }
 
-/// Unused values in front of and behind the phase-blocked rail arrays: the first
-/// slot of block 0 and the last of block `n - 1` read one of them as a neighbour. A
-/// whole vector of them, so that blocks start on a cache line.
+/// Unused values in front of and behind the phase-blocked rail arrays, always zero:
+/// the first slot of the first block in memory and the last slot of block `n - 1`
+/// read one of them as a neighbour. A whole vector of them, so that blocks start on a
+/// cache line.
 const GUARD: usize = LANES;
+
+/// First storage slot of phase block `p` of `n` whose rail parts are `sp` long: block
+/// 0 comes last in memory (after blocks `1..n`), so that the one slot past it, which
+/// the last slot of block `n - 1` reads as its right neighbour, is the trailing guard
+/// (see [`Track`] on why the padding then needs no clearing).
+#[inline(always)]
+fn block_start(p: usize, n: usize, sp: usize) -> usize {
+    GUARD + (p + n - 1) % n * 2 * sp
+}
 
 /// Pad forces (3.9) and sleeper update (3.18) for every sleeper: rail deflections
 /// above the sleepers at t_j (`rl`, `rr`) and t_(j-1) (`rlp`, `rrp`), sleeper bounce
@@ -568,8 +589,12 @@ fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
 
 /// One phase block of the rail stencil (3.12): centre nodes `zc`, `tc` with their
 /// left (`zl`, `tl`) and right (`zr`, `tr`) neighbours, new values written over the
-/// t_(j-1) values `zn`, `tn`. With `PAD` the block holds the sleeper nodes and the pad
-/// forces `pad` enter.
+/// t_(j-1) values `zn`, `tn`. With `PAD` the block is block 0: it holds the sleeper
+/// nodes, the pad forces `pad` enter, and the new values are masked by `keep` (bit
+/// patterns: all ones keep a value, zero clears it), which holds the rail ends and
+/// block 0's padding at exactly `+0.0` without a scalar store after the loop (a vector
+/// load of the next step over a slot just written by a scalar store cannot take its
+/// value from the store buffer and waits for the store to reach the cache).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn stencil_body<const PAD: bool, const FMA: bool>(
@@ -582,13 +607,20 @@ fn stencil_body<const PAD: bool, const FMA: bool>(
     zn: &mut [f64],
     tn: &mut [f64],
     pad: &[f64],
+    keep: &[f64],
     c: &Coeffs,
 ) {
     let m = zc.len();
     let (zl, zr) = (&zl[..m], &zr[..m]);
     let (tl, tc, tr) = (&tl[..m], &tc[..m], &tr[..m]);
     let (zn, tn) = (&mut zn[..m], &mut tn[..m]);
-    let pad = if PAD { &pad[..m] } else { &pad[..0] };
+    let (pad, keep) = if PAD {
+        (&pad[..m], &keep[..m])
+    } else {
+        (&pad[..0], &keep[..0])
+    };
+    // `v` with its bits and-ed with `mask`'s.
+    let masked = |v: f64, mask: f64| f64::from_bits(v.to_bits() & mask.to_bits());
     for i in 0..m {
         // (3.12) with the centre terms gathered: 5 multiply-adds per value.
         let znew = madd::<FMA>(
@@ -596,16 +628,18 @@ fn stencil_body<const PAD: bool, const FMA: bool>(
             tr[i] - tl[i],
             madd::<FMA>(c.zz, zr[i] + zl[i], madd::<FMA>(c.zc, zc[i], -zn[i])),
         );
-        zn[i] = if PAD {
-            madd::<FMA>(c.force, pad[i], znew)
-        } else {
-            znew
-        };
-        tn[i] = madd::<FMA>(
+        let tnew = madd::<FMA>(
             c.tz,
             zr[i] - zl[i],
             madd::<FMA>(c.tt, tr[i] + tl[i], madd::<FMA>(c.tc, tc[i], -tn[i])),
         );
+        if PAD {
+            zn[i] = masked(madd::<FMA>(c.force, pad[i], znew), keep[i]);
+            tn[i] = masked(tnew, keep[i]);
+        } else {
+            zn[i] = znew;
+            tn[i] = tnew;
+        }
     }
 }
 
@@ -614,9 +648,10 @@ fn stencil_body<const PAD: bool, const FMA: bool>(
 ///    update (3.18), in place over the t_(j-1) sleeper arrays; block 0 holds the rail
 ///    nodes above the sleepers;
 /// 2. the rail stencil block by block, each whole, written in place over the t_(j-1)
-///    rail arrays, the pad forces entering block 0. Block p's left neighbours are
-///    block p - 1 (block n - 1 one slot back for p = 0), its right neighbours block
-///    p + 1 (block 0 one slot on for p = n - 1).
+///    rail arrays, the pad forces entering block 0 and its mask `keep` clearing the
+///    rail ends and its padding. Block p's left neighbours are block p - 1 (block
+///    n - 1 one slot back for p = 0), its right neighbours block p + 1 (block 0 one
+///    slot on for p = n - 1).
 ///
 /// Inlined into [`step_body`], which is compiled once per SIMD level.
 #[allow(clippy::too_many_arguments)]
@@ -631,37 +666,40 @@ fn kernels_body<const FMA: bool>(
     zs_prev: &mut [f64],
     ph_prev: &mut [f64],
     pad: &mut [f64],
+    keep: &[f64],
     c: &Coeffs,
     n: usize,
 ) {
     let sp = zs.len();
     let b = 2 * sp;
-    let g = GUARD;
+    let block = |p: usize| block_start(p, n, sp)..block_start(p, n, sp) + b;
     {
-        let (rl, rr) = z[g..g + b].split_at(sp);
-        let (rlp, rrp) = z_prev[g..g + b].split_at(sp);
+        let (rl, rr) = z[block(0)].split_at(sp);
+        let (rlp, rrp) = z_prev[block(0)].split_at(sp);
         let (pl, pr) = pad.split_at_mut(sp);
         sleepers_body::<FMA>(rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s);
     }
     for p in 0..n {
-        let centre = g + p * b..g + (p + 1) * b;
+        let centre = block(p);
         let left = if p == 0 {
-            g + (n - 1) * b - 1..g + n * b - 1
+            let l = block(n - 1);
+            l.start - 1..l.end - 1
         } else {
-            centre.start - b..centre.end - b
+            block(p - 1)
         };
         let right = if p + 1 == n {
-            g + 1..g + b + 1
+            let r = block(0);
+            r.start + 1..r.end + 1
         } else {
-            centre.start + b..centre.end + b
+            block(p + 1)
         };
         let (zl, zc, zr) = (&z[left.clone()], &z[centre.clone()], &z[right.clone()]);
         let (tl, tc, tr) = (&th[left], &th[centre.clone()], &th[right]);
         let (zn, tn) = (&mut z_prev[centre.clone()], &mut th_prev[centre]);
         if p == 0 {
-            stencil_body::<true, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, pad, c);
+            stencil_body::<true, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, pad, keep, c);
         } else {
-            stencil_body::<false, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, &[], c);
+            stencil_body::<false, FMA>(zl, zc, zr, tl, tc, tr, zn, tn, &[], &[], c);
         }
     }
 }
@@ -685,6 +723,7 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
         zs_prev,
         ph_prev,
         pad,
+        keep,
         padding,
         ends_inner,
         slot,
@@ -698,28 +737,30 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
         RailEnds::Fixed => [0.0; 4],
     };
     // 1-2. Sleepers and pads, then the rail stencil (see `kernels_body`).
-    kernels_body::<FMA>(z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, c, n);
-    // 3. Wheel forces on the new rail state; end conditions; padding.
+    kernels_body::<FMA>(
+        z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, keep, c, n,
+    );
+    // 3. Wheel forces on the new rail state, the rail ends (which the loops left at
+    // zero) excepted.
     for l in loads {
         let (k, w) = locate(l.position, inv_dx, nk);
         let r = l.rail.min(1) * sp;
-        z_prev[slot[k] + r] -= c.force * (1.0 - w) * l.force;
-        z_prev[slot[k + 1] + r] -= c.force * w * l.force;
-    }
-    for &s in padding.iter() {
-        z_prev[s] = 0.0;
-        th_prev[s] = 0.0;
-    }
-    for &(e, _) in ends_inner.iter() {
-        z_prev[e] = 0.0;
+        if k > 0 {
+            z_prev[slot[k] + r] -= c.force * (1.0 - w) * l.force;
+        }
+        if k + 2 < nk {
+            z_prev[slot[k + 1] + r] -= c.force * w * l.force;
+        }
     }
     match params.ends {
-        RailEnds::Fixed => {
-            for &(e, _) in ends_inner.iter() {
-                th_prev[e] = 0.0;
-            }
-        }
+        // The padding stays at zero by itself (see `Track`).
+        RailEnds::Fixed => {}
         RailEnds::Pinned => {
+            // The end rotations are not zero, and padding next to an end reads them.
+            for &s in padding.iter() {
+                z_prev[s] = 0.0;
+                th_prev[s] = 0.0;
+            }
             // Ghost nodes: Z odd, theta even about the support.
             for (e, &(end, inner)) in ends_inner.iter().enumerate() {
                 let sgn = if e % 2 == 0 { 1.0 } else { -1.0 };
@@ -765,7 +806,7 @@ impl Track {
         let c = Coeffs::new(&params, dt);
         let b = 2 * sp;
         let len = GUARD + n * b + GUARD;
-        let slot: Vec<usize> = (0..nk).map(|k| GUARD + (k % n) * b + k / n).collect();
+        let slot: Vec<usize> = (0..nk).map(|k| block_start(k % n, n, sp) + k / n).collect();
         let mut used = vec![false; len];
         for &s in &slot {
             used[s] = true;
@@ -778,6 +819,14 @@ impl Track {
             (slot[0] + sp, slot[1] + sp),
             (slot[nk - 1] + sp, slot[nk - 2] + sp),
         ];
+        // Block 0's mask: every bit set over its interior nodes, none over the rail
+        // ends and the padding.
+        let mut keep = Aligned::zeros(b);
+        let start = block_start(0, n, sp);
+        for k in (n..nk - 1).step_by(n) {
+            keep[slot[k] - start] = f64::from_bits(u64::MAX);
+            keep[slot[k] + sp - start] = f64::from_bits(u64::MAX);
+        }
         Track {
             params,
             dt,
@@ -799,6 +848,7 @@ impl Track {
             zs_prev: Aligned::zeros(sp),
             ph_prev: Aligned::zeros(sp),
             pad: Aligned::zeros(2 * sp),
+            keep,
             simd: SimdLevel::detect(),
         }
     }
@@ -1063,7 +1113,8 @@ impl Track {
         let ls = 0.5 * self.params.rail_seat_distance;
         for i in 0..ns {
             // Block 0 holds the rail nodes above the sleepers.
-            let (zl, zr) = (self.z[GUARD + i], self.z[GUARD + sp + i]);
+            let s = block_start(0, self.params.nodes_per_span, sp) + i;
+            let (zl, zr) = (self.z[s], self.z[s + sp]);
             self.pad[i] = -self.params.pad_stiffness * (zl - self.zs[i] + ls * self.ph[i]);
             self.pad[sp + i] = -self.params.pad_stiffness * (zr - self.zs[i] - ls * self.ph[i]);
         }
@@ -1454,6 +1505,83 @@ mod tests {
                 worst > 0.0,
                 "the fused recurrence must differ from the unfused one"
             );
+        }
+    }
+
+    #[test]
+    fn padding_and_rail_ends_stay_at_zero_without_clearing() {
+        // Fixed ends: nothing clears the padding after a step, so it must stay at
+        // exactly +0.0 by the storage order alone (block 0 last); the rail ends are
+        // masked in the loop, loads in the end elements skip them. Pinned ends clear
+        // the padding. Loads sit in the first and last elements of both rails.
+        for (spans, n, ends) in [
+            (6, 1, RailEnds::Fixed),
+            (6, 2, RailEnds::Fixed),
+            (9, 3, RailEnds::Fixed),
+            (5, 4, RailEnds::Fixed),
+            (6, 3, RailEnds::Pinned),
+        ] {
+            let mut p = seed_track(spans, n);
+            p.ends = ends;
+            let mut t = Track::new(p, 0.9 * p.critical_time_step().0).unwrap();
+            let dx = p.dx();
+            let len = p.length();
+            let loads = [
+                PointLoad {
+                    rail: 0,
+                    position: 0.3 * dx,
+                    force: 1.0e5,
+                },
+                PointLoad {
+                    rail: 1,
+                    position: len - 0.6 * dx,
+                    force: 0.8e5,
+                },
+                PointLoad {
+                    rail: 0,
+                    position: 0.55 * len,
+                    force: 1.2e5,
+                },
+            ];
+            assert!(!t.padding.is_empty() || n == 1);
+            for _ in 0..2000 {
+                t.step(&loads);
+            }
+            let what = format!("{spans} spans, n = {n}, {ends:?}");
+            let zero = |a: &Aligned, s: usize| a[s].to_bits() == 0;
+            for a in [&t.z, &t.th, &t.z_prev, &t.th_prev] {
+                for &s in &t.padding {
+                    assert!(zero(a, s), "{what}: padding slot {s} holds {:e}", a[s]);
+                }
+                let tail = GUARD + n * 2 * t.sp;
+                for s in (0..GUARD).chain(tail..tail + GUARD) {
+                    assert!(zero(a, s), "{what}: guard {s} holds {:e}", a[s]);
+                }
+            }
+            for a in [&t.zs, &t.ph, &t.zs_prev, &t.ph_prev] {
+                assert!(
+                    a[t.ns..].iter().all(|v| v.to_bits() == 0),
+                    "{what}: padded sleeper"
+                );
+            }
+            for rail in 0..2 {
+                let z = t.rail_z(rail);
+                assert!(
+                    z[0].to_bits() == 0 && z[t.nk - 1].to_bits() == 0,
+                    "{what}: end Z"
+                );
+                assert!(
+                    z[1] != 0.0 && z[t.nk - 2] != 0.0,
+                    "{what}: the rail must move"
+                );
+                if ends == RailEnds::Fixed {
+                    let th = t.rail_theta(rail);
+                    assert!(
+                        th[0].to_bits() == 0 && th[t.nk - 1].to_bits() == 0,
+                        "{what}: end theta"
+                    );
+                }
+            }
         }
     }
 
