@@ -533,7 +533,8 @@ const GUARD: usize = LANES;
 /// (see [`Track`] on why the padding then needs no clearing).
 #[inline(always)]
 fn block_start(p: usize, n: usize, sp: usize) -> usize {
-    GUARD + (p + n - 1) % n * 2 * sp
+    // Not `(p + n - 1) % n`: an integer division in front of every loop.
+    GUARD + (if p == 0 { n - 1 } else { p - 1 }) * 2 * sp
 }
 
 /// Pad forces (3.9) and sleeper update (3.18) for every sleeper: rail deflections
@@ -742,14 +743,27 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     );
     // 3. Wheel forces on the new rail state, the rail ends (which the loops left at
     // zero) excepted.
-    for l in loads {
-        let (k, w) = locate(l.position, inv_dx, nk);
-        let r = l.rail.min(1) * sp;
+    let mut apply = |k: usize, w: f64, rail: usize, force: f64| {
+        let r = rail.min(1) * sp;
         if k > 0 {
-            z_prev[slot[k] + r] -= c.force * (1.0 - w) * l.force;
+            z_prev[slot[k] + r] -= c.force * (1.0 - w) * force;
         }
         if k + 2 < nk {
-            z_prev[slot[k + 1] + r] -= c.force * w * l.force;
+            z_prev[slot[k + 1] + r] -= c.force * w * force;
+        }
+    };
+    match loads {
+        // A wheelset: both wheels at one position, located once.
+        [a, b] if a.position == b.position => {
+            let (k, w) = locate(a.position, inv_dx, nk);
+            apply(k, w, a.rail, a.force);
+            apply(k, w, b.rail, b.force);
+        }
+        _ => {
+            for l in loads {
+                let (k, w) = locate(l.position, inv_dx, nk);
+                apply(k, w, l.rail, l.force);
+            }
         }
     }
     match params.ends {
