@@ -1831,7 +1831,10 @@ mod tests {
         .iter()
         .flat_map(|(l, s)| l.iter().zip(s.iter()).map(|(a, b)| (a - b).abs()))
         .fold(0.0f64, f64::max);
-        assert!(worst < 1e-11 * peak, "bowls differ by {worst:e} of {peak:e}");
+        assert!(
+            worst < 1e-11 * peak,
+            "bowls differ by {worst:e} of {peak:e}"
+        );
         assert!(long.3.abs() < 1e-12 * peak, "far field {:e}", long.3);
         assert!(took < 5.0, "static solve of 72,006 unknowns took {took} s");
     }
