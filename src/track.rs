@@ -405,6 +405,13 @@ impl SimdLevel {
     }
 }
 
+/// `f` itself: lets a closure be marked `#[inline(always)]` where it is defined
+/// (attributes on closures are allowed only in argument position).
+#[inline(always)]
+fn inlined<F>(f: F) -> F {
+    f
+}
+
 /// Lanes of the widest vectors: the sleeper arrays and each rail's part of a block
 /// are padded to a multiple of this, so that every loop runs in whole vectors.
 const LANES: usize = 8;
@@ -743,15 +750,18 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     );
     // 3. Wheel forces on the new rail state, the rail ends (which the loops left at
     // zero) excepted.
-    let mut apply = |k: usize, w: f64, rail: usize, force: f64| {
-        let r = rail.min(1) * sp;
-        if k > 0 {
-            z_prev[slot[k] + r] -= c.force * (1.0 - w) * force;
-        }
-        if k + 2 < nk {
-            z_prev[slot[k + 1] + r] -= c.force * w * force;
-        }
-    };
+    let mut apply = inlined(
+        #[inline(always)]
+        |k: usize, w: f64, rail: usize, force: f64| {
+            let r = rail.min(1) * sp;
+            if k > 0 {
+                z_prev[slot[k] + r] -= c.force * (1.0 - w) * force;
+            }
+            if k + 2 < nk {
+                z_prev[slot[k + 1] + r] -= c.force * w * force;
+            }
+        },
+    );
     match loads {
         // A wheelset: both wheels at one position, located once.
         [a, b] if a.position == b.position => {
