@@ -100,7 +100,13 @@ pub fn patch_angle(delta: f64, radius: f64) -> f64 {
 /// cancellation of the difference never happens. Above, the library functions.
 #[inline]
 fn perfect_patch(delta: f64, radius: f64) -> (f64, f64, f64) {
-    let x = (delta * (0.5 / radius)).clamp(0.0, 1.0);
+    perfect_patch_scaled(delta * (0.5 / radius))
+}
+
+/// [`perfect_patch`] of `x = delta / (2 R_w)`.
+#[inline]
+fn perfect_patch_scaled(x: f64) -> (f64, f64, f64) {
+    let x = x.clamp(0.0, 1.0);
     if x <= 0.0025 {
         let s = x.sqrt();
         (
@@ -229,9 +235,26 @@ impl ContactLaw {
     /// and overlap `overlap = z_rail - z_wheel` (m).
     #[inline(always)]
     pub fn evaluate(&self, wheel: &WheelProfile, gamma: f64, overlap: f64) -> ContactState {
+        let mut state = ContactState::default();
+        self.evaluate_into(wheel, gamma, overlap, &mut state);
+        state
+    }
+
+    /// [`ContactLaw::evaluate`] written into `out`, the caller's own place for the
+    /// state. The coupled step writes the states where its sample keeps them: a state
+    /// built in a temporary and copied at once stalled the copy's wide loads on the
+    /// narrow stores that had just built it.
+    #[inline(always)]
+    pub fn evaluate_into(
+        &self,
+        wheel: &WheelProfile,
+        gamma: f64,
+        overlap: f64,
+        out: &mut ContactState,
+    ) {
         match self.model {
-            ContactModel::Adaptive => adaptive(self.kw, wheel, gamma, overlap, false),
-            ContactModel::Hertz => self.hertz_state(wheel, gamma, overlap),
+            ContactModel::Adaptive => adaptive(self.kw, wheel, gamma, overlap, false, out),
+            ContactModel::Hertz => *out = self.hertz_state(wheel, gamma, overlap),
         }
     }
 
@@ -246,8 +269,8 @@ impl ContactLaw {
         }
         // The Hertz law knows no patch; report the geometric overlap patch of a
         // circle of the nominal radius pressed in by d.
-        let a = patch_angle(d, wheel.radius);
-        let h = wheel.radius - d;
+        let a = patch_angle(d, wheel.radius());
+        let h = wheel.radius() - d;
         ContactState {
             force: self.ch * d * d.sqrt(),
             overlap,
@@ -266,7 +289,7 @@ impl ContactLaw {
         }
         let mut lo = 0.0;
         let mut hi = 1e-4;
-        while self.evaluate(wheel, gamma, hi).force < force && hi < wheel.radius {
+        while self.evaluate(wheel, gamma, hi).force < force && hi < wheel.radius() {
             lo = hi;
             hi *= 2.0;
         }
@@ -288,7 +311,9 @@ impl ContactLaw {
 /// Adaptive force by numerical integration even for a perfect wheel; for tests and
 /// for checking the closed form.
 pub fn adaptive_numeric(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f64) -> ContactState {
-    adaptive(kw, wheel, gamma, overlap, true)
+    let mut state = ContactState::default();
+    adaptive(kw, wheel, gamma, overlap, true, &mut state);
+    state
 }
 
 #[inline(always)]
@@ -298,16 +323,18 @@ fn adaptive(
     gamma: f64,
     overlap: f64,
     force_numeric: bool,
-) -> ContactState {
-    let rw = wheel.radius;
+    out: &mut ContactState,
+) {
+    let rw = wheel.radius();
     if overlap <= 0.0 || overlap.is_nan() {
-        return ContactState {
+        *out = ContactState {
             overlap,
             ..Default::default()
         };
+        return;
     }
     let delta = overlap.min(rw);
-    let (aw, sin_minus_x_cos_aw, s2) = perfect_patch(delta, rw);
+    let (aw, sin_minus_x_cos_aw, s2) = perfect_patch_scaled(delta * wheel.half_inv_radius());
     // Flats whose window (space angles) reaches into [-aw, aw], with their centres.
     let mut near = [(0.0f64, 0usize); MAX_FLATS];
     let mut nf = 0;
@@ -320,7 +347,7 @@ fn adaptive(
     }
     if nf == 0 && !force_numeric {
         // sin(alpha_w) = 2 s sqrt(1 - s^2) with s = sin(alpha_w / 2) = sqrt(delta / 2 R_w).
-        return ContactState {
+        *out = ContactState {
             force: 2.0 * kw * rw * sin_minus_x_cos_aw,
             overlap,
             front_angle: aw,
@@ -328,8 +355,9 @@ fn adaptive(
             length: 4.0 * rw * (s2 * (1.0 - s2)).sqrt(),
             intervals: 1,
         };
+        return;
     }
-    adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric)
+    *out = adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric);
 }
 
 /// The adaptive integral when flats reach into the patch `[-aw, aw]` (rad) at overlap
@@ -368,7 +396,7 @@ fn adaptive_flats_body(
     aw: f64,
     force_numeric: bool,
 ) -> ContactState {
-    let rw = wheel.radius;
+    let rw = wheel.radius();
     let h = rw - delta;
     let flats = wheel.flats();
     // The closures are marked `#[inline(always)]` (through `inlined`, as attributes on
@@ -754,8 +782,8 @@ mod tests {
     const KW: f64 = 3.3443e10;
 
     fn brute_force(kw: f64, w: &WheelProfile, gamma: f64, delta: f64, n: usize) -> f64 {
-        let aw = patch_angle(delta, w.radius);
-        let h = w.radius - delta;
+        let aw = patch_angle(delta, w.radius());
+        let h = w.radius() - delta;
         let da = 2.0 * aw / n as f64;
         let mut s = 0.0;
         for i in 0..n {

@@ -291,7 +291,9 @@ pub const MAX_FLATS: usize = 8;
 #[derive(Debug, Clone, PartialEq)]
 pub struct WheelProfile {
     /// Nominal rolling radius `R_w` (m).
-    pub radius: f64,
+    radius: f64,
+    /// `1 / (2 R_w)` (1/m): the contact scales every overlap by it.
+    half_inv_radius: f64,
     flats: Vec<Flat>,
 }
 
@@ -301,8 +303,22 @@ impl WheelProfile {
         positive("wheel.radius", radius, "m")?;
         Ok(WheelProfile {
             radius,
+            half_inv_radius: 0.5 / radius,
             flats: Vec::new(),
         })
+    }
+
+    /// Nominal rolling radius `R_w` (m).
+    #[inline]
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// `1 / (2 R_w)` (1/m), kept so that the contact does not divide by the radius
+    /// on every evaluation.
+    #[inline]
+    pub(crate) fn half_inv_radius(&self) -> f64 {
+        self.half_inv_radius
     }
 
     /// A wheel with flats; `name` prefixes parameter names in errors

@@ -86,6 +86,8 @@ pub struct Simulation {
     /// The sample at the current time and inputs, once computed (a co-simulation
     /// master reads the outputs and then steps: the contact is evaluated once).
     cached: Cell<Option<Sample>>,
+    /// The sample of the latest step, built here in place by [`Simulation::step`].
+    latest: Sample,
     /// Instructions the whole coupled step is compiled for (see [`Simulation::step`]).
     simd: SimdLevel,
 }
@@ -104,6 +106,35 @@ fn wheel_loads(x: f64, p: [f64; 2]) -> [PointLoad; 2] {
             force: p[1],
         },
     ]
+}
+
+/// The contact states of sample `s`, whose head (time, rotation, wheel and rail
+/// displacements) is set, written in place.
+#[inline(always)]
+fn contact_states(
+    vehicle: &VehicleState,
+    law: &ContactLaw,
+    wheels: &[WheelProfile; 2],
+    s: &mut Sample,
+) {
+    match vehicle {
+        VehicleState::ConstantLoad(p) => {
+            for (c, &force) in s.contact.iter_mut().zip(p) {
+                *c = ContactState {
+                    force,
+                    intervals: 1,
+                    ..Default::default()
+                };
+            }
+        }
+        _ => {
+            let gamma = wrap_turns(s.rotation);
+            for i in 0..2 {
+                let overlap = s.rail_z[i] - s.wheel_z[i];
+                law.evaluate_into(&wheels[i], gamma, overlap, &mut s.contact[i]);
+            }
+        }
+    }
 }
 
 /// Angle `a` (rad) wrapped into [0, 2 pi).
@@ -226,6 +257,7 @@ impl Simulation {
             max_force: [f64::NEG_INFINITY; 2],
             min_force: [f64::INFINITY; 2],
             cached: Cell::new(None),
+            latest: Sample::default(),
             simd: SimdLevel::detect(),
         };
         sim.set_static()?;
@@ -393,40 +425,20 @@ impl Simulation {
 
     #[inline(always)]
     fn compute_sample(&self) -> Sample {
+        let mut s = Sample::default();
+        self.sample_head(&mut s);
+        contact_states(&self.vehicle, &self.law, &self.wheels, &mut s);
+        s
+    }
+
+    /// Everything of the sample at the current time but the contact states, written
+    /// into `s`.
+    #[inline(always)]
+    fn sample_head(&self, s: &mut Sample) {
         let time = self.time();
         let position = self.scenario.start_position + self.scenario.speed * time;
-        let wheel_z = self.wheel_z();
-        let rail_z = self.rail_z_under(position);
-        let rotation = self.rotation();
-        let gamma = wrap_turns(rotation);
-        let contact = match &self.vehicle {
-            VehicleState::ConstantLoad(p) => [
-                ContactState {
-                    force: p[0],
-                    intervals: 1,
-                    ..Default::default()
-                },
-                ContactState {
-                    force: p[1],
-                    intervals: 1,
-                    ..Default::default()
-                },
-            ],
-            _ => [
-                self.law
-                    .evaluate(&self.wheels[0], gamma, rail_z[0] - wheel_z[0]),
-                self.law
-                    .evaluate(&self.wheels[1], gamma, rail_z[1] - wheel_z[1]),
-            ],
-        };
-        Sample {
-            time,
-            position,
-            rotation,
-            wheel_z,
-            rail_z,
-            contact,
-        }
+        (s.time, s.position, s.rotation) = (time, position, self.rotation());
+        (s.wheel_z, s.rail_z) = (self.wheel_z(), self.rail_z_under(position));
     }
 
     /// Instructions the coupled step runs with.
@@ -481,25 +493,34 @@ impl Simulation {
             }
         }
         // The cached sample, if the outputs were read at this instant, is used up here;
-        // otherwise the sample is built where it is returned (no copies on the way).
+        // otherwise the sample is built in place in `latest` and copied out once the
+        // step is done (a sample built in a temporary was copied at once, and the
+        // copy's wide loads waited on the narrow stores that had just built it).
         if let Some(s) = self.cached.take() {
-            self.advance_with(x, &s)?;
-            return Ok(s);
+            self.latest = s;
+        } else {
+            let time = self.time();
+            let position = self.scenario.start_position + self.scenario.speed * time;
+            let (rotation, wheel_z) = (self.rotation(), self.wheel_z());
+            let rail_z = self.rail_z_under(position);
+            let s = &mut self.latest;
+            (s.time, s.position, s.rotation) = (time, position, rotation);
+            (s.wheel_z, s.rail_z) = (wheel_z, rail_z);
+            contact_states(&self.vehicle, &self.law, &self.wheels, s);
         }
-        let s = self.compute_sample();
-        self.advance_with(x, &s)?;
-        Ok(s)
+        let s = &self.latest;
+        self.advance_with(x, [s.contact[0].force, s.contact[1].force], s.time)?;
+        Ok(self.latest)
     }
 
-    /// Advances vehicle and track from `t_j` with the contact forces of `s`, the sample
-    /// at `t_j`, the wheels at position `x` (m).
+    /// Advances vehicle and track from `t_j` (s) with the contact forces `p` (N) of
+    /// the sample at `t_j`, the wheels at position `x` (m).
     #[inline(always)]
-    fn advance_with(&mut self, x: f64, s: &Sample) -> Result<()> {
-        let p = [s.contact[0].force, s.contact[1].force];
+    fn advance_with(&mut self, x: f64, p: [f64; 2], time: f64) -> Result<()> {
         if !(p[0].is_finite() && p[1].is_finite()) {
             return Err(Error::NonFinite {
                 what: "contact force".into(),
-                time: s.time,
+                time,
             });
         }
         for i in 0..2 {
