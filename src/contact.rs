@@ -15,7 +15,7 @@ use crate::error::{Result, out_of_range, positive};
 use crate::profile::{
     LANES, MAX_FLATS, SMALL_ANGLE, WheelProfile, cos_poly, cos_small, wrap_angle,
 };
-use crate::track::SimdLevel;
+use crate::track::{SimdLevel, inlined};
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.
@@ -636,12 +636,6 @@ fn adaptive_flats_body(
         length: h * (front.tan() - rear.tan()),
         intervals,
     }
-}
-
-/// `f` itself: lets a closure be marked `#[inline(always)]` where it is defined.
-#[inline(always)]
-fn inlined<F>(f: F) -> F {
-    f
 }
 
 /// Rounding allowance (m) in the curvature test for slivers: far above the rounding

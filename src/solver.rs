@@ -426,19 +426,25 @@ impl Simulation {
     #[inline(always)]
     fn compute_sample(&self) -> Sample {
         let mut s = Sample::default();
-        self.sample_head(&mut s);
+        (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = self.sample_head();
         contact_states(&self.vehicle, &self.law, &self.wheels, &mut s);
         s
     }
 
-    /// Everything of the sample at the current time but the contact states, written
-    /// into `s`.
+    /// Everything of the sample at the current time but the contact states: time (s),
+    /// position (m), axle rotation (rad), wheel and rail displacements (m).
     #[inline(always)]
-    fn sample_head(&self, s: &mut Sample) {
+    fn sample_head(&self) -> (f64, f64, f64, [f64; 2], [f64; 2]) {
         let time = self.time();
         let position = self.scenario.start_position + self.scenario.speed * time;
-        (s.time, s.position, s.rotation) = (time, position, self.rotation());
-        (s.wheel_z, s.rail_z) = (self.wheel_z(), self.rail_z_under(position));
+        let (rotation, wheel_z) = (self.rotation(), self.wheel_z());
+        (
+            time,
+            position,
+            rotation,
+            wheel_z,
+            self.rail_z_under(position),
+        )
     }
 
     /// Instructions the coupled step runs with.
@@ -499,13 +505,9 @@ impl Simulation {
         if let Some(s) = self.cached.take() {
             self.latest = s;
         } else {
-            let time = self.time();
-            let position = self.scenario.start_position + self.scenario.speed * time;
-            let (rotation, wheel_z) = (self.rotation(), self.wheel_z());
-            let rail_z = self.rail_z_under(position);
+            let head = self.sample_head();
             let s = &mut self.latest;
-            (s.time, s.position, s.rotation) = (time, position, rotation);
-            (s.wheel_z, s.rail_z) = (wheel_z, rail_z);
+            (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
             contact_states(&self.vehicle, &self.law, &self.wheels, s);
         }
         let s = &self.latest;

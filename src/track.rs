@@ -406,9 +406,10 @@ impl SimdLevel {
 }
 
 /// `f` itself: lets a closure be marked `#[inline(always)]` where it is defined
-/// (attributes on closures are allowed only in argument position).
+/// (attributes on closures are allowed only in argument position), so that
+/// [`SimdLevel::run`] compiles it into each level's copy.
 #[inline(always)]
-fn inlined<F>(f: F) -> F {
+pub(crate) fn inlined<F>(f: F) -> F {
     f
 }
 
