@@ -8,7 +8,8 @@
 //! both step), the pair performs exactly the arithmetic of the monolithic
 //! [`crate::solver::Simulation`].
 
-use crate::error::{Error, Result, finite, non_negative, out_of_range, positive};
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
+use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MIN_DT_FRACTION, check, within};
 use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
 use nalgebra::Vector6;
 
@@ -44,24 +45,37 @@ pub struct VehicleUnit {
 impl VehicleUnit {
     /// Builds the vehicle at rest on the static wheel displacements.
     pub fn new(p: &VehicleUnitParams) -> Result<Self> {
-        finite("speed", p.speed, "m/s")?;
-        if p.speed < 0.0 {
-            return Err(out_of_range("speed", p.speed, ">= 0 m/s"));
-        }
-        positive("wheel.radius", p.wheel_radius, "m")?;
+        check("speed", p.speed)?;
+        check("wheel.radius", p.wheel_radius)?;
         non_negative("solver.dt", p.dt, "s")?;
-        finite("static_wheel_z.left", p.static_wheel_z[0], "m")?;
-        finite("static_wheel_z.right", p.static_wheel_z[1], "m")?;
+        check("static_wheel_z.left", p.static_wheel_z[0])?;
+        check("static_wheel_z.right", p.static_wheel_z[1])?;
         p.vehicle.validate()?;
+        let critical = p.vehicle.critical_time_step();
         let dt = if p.dt == 0.0 {
             p.vehicle.default_dt()
         } else {
             p.dt
         };
+        if !(dt >= MIN_DT_FRACTION * critical && dt <= 0.5 * critical) {
+            return Err(out_of_range(
+                "solver.dt",
+                dt,
+                format!(
+                    "0 (the default, {} s) or {} s <= solver.dt <= {} s (half the critical step \
+                     {} s of the fastest suspension mode: the step changes that communication \
+                     steps force stay stable below it)",
+                    num(p.vehicle.default_dt()),
+                    num(MIN_DT_FRACTION * critical),
+                    num(0.5 * critical),
+                    num(critical)
+                ),
+            ));
+        }
         let mut vehicle = RollPlaneVehicle::new(p.vehicle, dt)?;
-        vehicle.set_static(p.static_wheel_z);
+        vehicle.set_static(p.static_wheel_z)?;
         let w = p.vehicle.static_wheel_load();
-        Ok(VehicleUnit {
+        let unit = VehicleUnit {
             params: *p,
             vehicle,
             dt_base: dt,
@@ -70,7 +84,9 @@ impl VehicleUnit {
             force: [w, w],
             max_force: [w, w],
             min_force: [w, w],
-        })
+        };
+        unit.check_states()?;
+        Ok(unit)
     }
 
     /// Parameters.
@@ -129,16 +145,41 @@ impl VehicleUnit {
         Ok(())
     }
 
-    /// Advances by a communication step `h` (s) in `ceil(h / dt_base)` equal substeps
-    /// with the contact forces held.
-    pub fn advance(&mut self, h: f64) -> Result<()> {
+    /// Number of steps a communication step `h` (s) takes: `ceil(h / dt_base)`, `h`
+    /// first reduced by `tolerance` (s), the rounding of the master's clock, so a step
+    /// that is a whole multiple of the base step up to that rounding takes exactly that
+    /// many steps.
+    pub fn steps_for(&self, h: f64, tolerance: f64) -> f64 {
+        ((h - tolerance) / self.dt_base).ceil().max(1.0)
+    }
+
+    /// Advances by a communication step `h` (s) with the contact forces held, in
+    /// [`VehicleUnit::steps_for`] steps. When `h` is that many steps of the step in use
+    /// to within `tolerance` (s), the steps are taken as they are; otherwise the step
+    /// changes to `h / n` (first-order accurate at the change; stable for any sequence
+    /// of changes, since every step stays below half the critical step).
+    ///
+    /// Errors: `h` not positive or below `1e-6` of the base step (a step that short
+    /// would round the velocities away); a vehicle displacement beyond
+    /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`] or a wheel beyond
+    /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`Error::Diverged`]).
+    pub fn advance(&mut self, h: f64, tolerance: f64) -> Result<()> {
         positive("communication step", h, "s")?;
-        let n = ((h / self.dt_base) * (1.0 - 1e-12)).ceil().max(1.0);
-        let sub = h / n;
-        if sub != self.vehicle.dt() {
+        if h < 1e-6 * self.dt_base {
+            return Err(out_of_range(
+                "communication step",
+                h,
+                format!(
+                    ">= 1e-6 solver.step = {} s (a shorter step rounds the velocities away)",
+                    num(1e-6 * self.dt_base)
+                ),
+            ));
+        }
+        let n = self.steps_for(h, tolerance);
+        if (h - n * self.vehicle.dt()).abs() > tolerance {
             self.t0 = self.time();
             self.k = 0;
-            self.vehicle.change_dt(sub)?;
+            self.vehicle.change_dt(h / n)?;
         }
         for i in 0..2 {
             self.max_force[i] = self.max_force[i].max(self.force[i]);
@@ -148,14 +189,52 @@ impl VehicleUnit {
             self.vehicle.step(self.force);
             self.k += 1;
         }
+        self.check_states()
+    }
+
+    /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
+    pub fn check_states(&self) -> Result<()> {
         let d = self.vehicle.displacements();
-        if !d.iter().all(|x| x.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "vehicle displacement".into(),
+        let wheels = self.vehicle.wheel_z();
+        let bad = d
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                (
+                    crate::vehicle::BODY_DOFS[i].to_string(),
+                    x,
+                    BODY_DISPLACEMENT_LIMIT,
+                )
+            })
+            .chain([
+                (
+                    "wheel.left.z (m)".to_string(),
+                    wheels[0],
+                    DISPLACEMENT_LIMIT,
+                ),
+                (
+                    "wheel.right.z (m)".to_string(),
+                    wheels[1],
+                    DISPLACEMENT_LIMIT,
+                ),
+            ])
+            .find(|(_, x, lim)| !within(*x, *lim));
+        match bad {
+            None => Ok(()),
+            Some((what, value, limit)) => Err(Error::Diverged {
+                what,
+                value,
+                limit,
                 time: self.time(),
-            });
+                cause: format!(
+                    "likely contact forces that do not carry the vehicle (contact.left.force = {} N, \
+                     contact.right.force = {} N against a static load of {} N per wheel)",
+                    num(self.force[0]),
+                    num(self.force[1]),
+                    num(self.static_load()[0])
+                ),
+            }),
         }
-        Ok(())
     }
 
     /// Everything that determines the continuation; [`VehicleUnit::set_state_vector`]
@@ -203,7 +282,7 @@ mod tests {
 
     /// Couples an external-wheel track simulation with a vehicle unit, as two FMUs
     /// would be coupled, and returns the contact forces per step.
-    fn run_pair(s: &Scenario, h_per_dt: f64, steps: usize) -> Vec<[f64; 2]> {
+    fn run_pair(s: &Scenario, h_per_dt: u64, steps: usize) -> Vec<[f64; 2]> {
         let VehicleSpec::RollPlane(vp) = s.vehicle else {
             panic!("roll-plane scenario expected")
         };
@@ -221,7 +300,7 @@ mod tests {
             static_wheel_z: track.wheel_z(),
         })
         .unwrap();
-        let h = track.dt() * h_per_dt;
+        let h = track.dt() * h_per_dt as f64;
         let mut out = Vec::new();
         for _ in 0..steps {
             track
@@ -231,8 +310,8 @@ mod tests {
             let p = [c[0].force, c[1].force];
             veh.set_forces(p).unwrap();
             out.push(p);
-            track.advance(h).unwrap();
-            veh.advance(h).unwrap();
+            track.advance_steps(h_per_dt).unwrap();
+            veh.advance(h, 0.0).unwrap();
         }
         out
     }
@@ -243,7 +322,7 @@ mod tests {
         s.set_nodes_per_span(2);
         s.dt = 45e-6;
         let steps = 4000; // 0.18 s: passes the first impact of the flat
-        let pair = run_pair(&s, 1.0, steps);
+        let pair = run_pair(&s, 1, steps);
         let mut sim = Simulation::new(&s).unwrap();
         let mut peak = 0.0f64;
         for (j, p) in pair.iter().enumerate() {
@@ -274,11 +353,11 @@ mod tests {
         };
         let mut a = VehicleUnit::new(&p).unwrap();
         a.set_forces([150e3, 90e3]).unwrap();
-        a.advance(3.3e-3).unwrap();
+        a.advance(3.3e-3, 0.0).unwrap();
         let mut b = VehicleUnit::new(&p).unwrap();
         b.set_state_vector(&a.state_vector()).unwrap();
-        a.advance(1e-3).unwrap();
-        b.advance(1e-3).unwrap();
+        a.advance(1e-3, 0.0).unwrap();
+        b.advance(1e-3, 0.0).unwrap();
         assert_eq!(a.state_vector(), b.state_vector());
     }
 

@@ -40,8 +40,32 @@ pub enum Error {
         /// Simulation time (s).
         time: f64,
     },
+    /// A value no physical run reaches (see [`crate::limits`]): the scheme diverged or
+    /// the inputs are not a running wheel.
+    Diverged {
+        /// Which quantity, with its unit (e.g. `contact force on the left wheel (N)`).
+        what: String,
+        /// Its value.
+        value: f64,
+        /// The bound it passed.
+        limit: f64,
+        /// Simulation time (s).
+        time: f64,
+        /// The likely cause, in words.
+        cause: String,
+    },
     /// A request this model does not support.
     Unsupported(String),
+}
+
+/// A number for a message: plain where that is short, in exponent form otherwise.
+pub fn num(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }
 
 impl fmt::Display for Error {
@@ -53,7 +77,8 @@ impl fmt::Display for Error {
                 allowed,
             } => write!(
                 f,
-                "parameter `{name}` = {value} is out of range: allowed {allowed}"
+                "parameter `{name}` = {} is out of range: allowed {allowed}",
+                num(*value)
             ),
             Error::UnstableTimeStep {
                 dt,
@@ -76,6 +101,18 @@ impl fmt::Display for Error {
             Error::NonFinite { what, time } => {
                 write!(f, "{what} became non-finite at t = {time} s")
             }
+            Error::Diverged {
+                what,
+                value,
+                limit,
+                time,
+                cause,
+            } => write!(
+                f,
+                "{what} = {} at t = {time} s is beyond {}, which no physical run reaches: {cause}",
+                num(*value),
+                num(*limit)
+            ),
             Error::Unsupported(what) => write!(f, "not supported: {what}"),
         }
     }

@@ -17,6 +17,7 @@ pub mod contact;
 pub mod cosim;
 pub mod error;
 pub mod fmu;
+pub mod limits;
 pub mod params;
 pub mod profile;
 pub mod solver;

@@ -6,7 +6,11 @@
 //! the static equilibrium of the whole system, solved directly.
 
 use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
-use crate::error::{Error, Result, finite, non_negative, out_of_range, positive};
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
+use crate::limits::{
+    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MIN_DT_FRACTION,
+    force_limit, within,
+};
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
 use crate::track::{PointLoad, SimdLevel, Track};
@@ -72,15 +76,14 @@ pub struct Simulation {
     wheels: [WheelProfile; 2],
     law: ContactLaw,
     dt: f64,
-    /// Step asked for by the scenario (or its default) (s): communication steps are
-    /// cut into substeps no longer than this.
-    dt_base: f64,
     /// Time at which the current step size began (s).
     t0: f64,
     /// Steps taken since `t0`.
     k: u64,
     steps: u64,
     static_load: [f64; 2],
+    /// Largest contact force a physical run reaches (N) ([`crate::limits::force_limit`]).
+    force_limit: f64,
     max_force: [f64; 2],
     min_force: [f64; 2],
     /// The sample at the current time and inputs, once computed (a co-simulation
@@ -184,6 +187,23 @@ impl Simulation {
         non_negative("contact.Kw", s.kw, "N/m/rad")?;
         non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
         let dt = if s.dt == 0.0 { default_dt(s) } else { s.dt };
+        if let TrackSpec::Discrete(p) = &s.track {
+            p.validate()?;
+            let (critical, _) = p.critical_time_step();
+            if dt < MIN_DT_FRACTION * critical {
+                return Err(out_of_range(
+                    "solver.dt",
+                    dt,
+                    format!(
+                        "0 (the default, {} s) or {} s <= solver.dt <= {} s (the critical step; \
+                         a step below {MIN_DT_FRACTION} of it resolves nothing more)",
+                        num(DEFAULT_DT_FRACTION * critical),
+                        num(MIN_DT_FRACTION * critical),
+                        num(critical)
+                    ),
+                ));
+            }
+        }
         let wheels = [
             WheelProfile::new(s.wheel_radius, &s.flats[0], "flat.left")?,
             WheelProfile::new(s.wheel_radius, &s.flats[1], "flat.right")?,
@@ -249,11 +269,11 @@ impl Simulation {
             wheels,
             law,
             dt,
-            dt_base: dt,
             t0: 0.0,
             k: 0,
             steps: 0,
             static_load,
+            force_limit: force_limit(static_load),
             max_force: [f64::NEG_INFINITY; 2],
             min_force: [f64::INFINITY; 2],
             cached: Cell::new(None),
@@ -261,6 +281,7 @@ impl Simulation {
             simd: SimdLevel::detect(),
         };
         sim.set_static()?;
+        sim.check_states()?;
         Ok(sim)
     }
 
@@ -287,7 +308,7 @@ impl Simulation {
         ];
         let zw = [zr[0] - delta[0], zr[1] - delta[1]];
         match &mut self.vehicle {
-            VehicleState::RollPlane(v) => v.set_static(zw),
+            VehicleState::RollPlane(v) => v.set_static(zw)?,
             VehicleState::LumpedWheels(v) => v.set_static(zw),
             VehicleState::ConstantLoad(_) => {}
             VehicleState::External { wheel_z, .. } => *wheel_z = zw,
@@ -320,6 +341,27 @@ impl Simulation {
                 *rotation + self.scenario.speed * (self.time() - since) / self.scenario.wheel_radius
             }
             _ => self.scenario.speed * self.time() / self.scenario.wheel_radius,
+        }
+    }
+
+    /// Rail nodes of the discrete track, both rails (the work of one track step scales
+    /// with it); 2 for the lumped track.
+    pub fn rail_nodes(&self) -> usize {
+        match &self.track {
+            TrackState::Discrete(t) => 2 * t.nodes(),
+            TrackState::Lumped(_) => 2,
+        }
+    }
+
+    /// Time (s) at which the wheel reaches the end of the discrete track, from the start;
+    /// `None` for the lumped track or at speed 0.
+    pub fn time_at_track_end(&self) -> Option<f64> {
+        let s = &self.scenario;
+        match &self.track {
+            TrackState::Discrete(t) if s.speed > 0.0 => {
+                Some((t.params().length() - s.start_position) / s.speed)
+            }
+            _ => None,
         }
     }
 
@@ -364,28 +406,61 @@ impl Simulation {
 
     /// Sets the wheel inputs of a simulation with [`VehicleSpec::External`] wheels:
     /// wheel-centre displacements `[left, right]` (m) and the axle rotation angle (rad)
-    /// at the current time. Refused for any other vehicle and for non-finite values.
+    /// at the current time ([`Simulation::set_wheel_z`], [`Simulation::set_rotation`]).
     pub fn set_wheel_inputs(&mut self, z: [f64; 2], gamma: f64) -> Result<()> {
-        finite("wheel.left.z", z[0], "m")?;
-        finite("wheel.right.z", z[1], "m")?;
+        self.set_wheel_z(z)?;
+        self.set_rotation(gamma)
+    }
+
+    /// Sets the wheel-centre displacements `[left, right]` (m) of a simulation with
+    /// [`VehicleSpec::External`] wheels. The axle rotation is not touched: it keeps
+    /// turning at `V / R_w` from the last angle given to [`Simulation::set_rotation`].
+    /// Refused for any other vehicle, and outside `|z| <=`
+    /// [`crate::limits::DISPLACEMENT_LIMIT`].
+    pub fn set_wheel_z(&mut self, z: [f64; 2]) -> Result<()> {
+        for (name, x) in [("wheel.left.z", z[0]), ("wheel.right.z", z[1])] {
+            if !within(x, DISPLACEMENT_LIMIT) {
+                return Err(out_of_range(
+                    name,
+                    x,
+                    format!(
+                        "-{DISPLACEMENT_LIMIT} m <= {name} <= {DISPLACEMENT_LIMIT} m (static \
+                         wheel heights are about -1.4 mm)"
+                    ),
+                ));
+            }
+        }
+        match &mut self.vehicle {
+            VehicleState::External { wheel_z, .. } => {
+                *wheel_z = z;
+                self.cached.set(None);
+                Ok(())
+            }
+            _ => Err(Self::not_external()),
+        }
+    }
+
+    /// Sets the axle rotation angle `gamma` (rad) at the current time of a simulation
+    /// with [`VehicleSpec::External`] wheels; from now on the axle turns at `V / R_w`
+    /// from it (2.17). Refused for any other vehicle and for a non-finite angle.
+    pub fn set_rotation(&mut self, gamma: f64) -> Result<()> {
         finite("wheel.rotation", gamma, "rad")?;
         let now = self.time();
         match &mut self.vehicle {
             VehicleState::External {
-                wheel_z,
-                rotation,
-                since,
+                rotation, since, ..
             } => {
-                *wheel_z = z;
                 *rotation = gamma;
                 *since = now;
                 self.cached.set(None);
                 Ok(())
             }
-            _ => Err(Error::Unsupported(
-                "wheel inputs for a simulation that has its own vehicle".into(),
-            )),
+            _ => Err(Self::not_external()),
         }
+    }
+
+    fn not_external() -> Error {
+        Error::Unsupported("wheel inputs for a simulation that has its own vehicle".into())
     }
 
     /// Rail displacements under the wheels (m) (3.23).
@@ -511,19 +586,153 @@ impl Simulation {
             contact_states(&self.vehicle, &self.law, &self.wheels, s);
         }
         let s = &self.latest;
+        let (zw, zr) = (s.wheel_z, s.rail_z);
+        if !(within(zw[0], DISPLACEMENT_LIMIT)
+            && within(zw[1], DISPLACEMENT_LIMIT)
+            && within(zr[0], DISPLACEMENT_LIMIT)
+            && within(zr[1], DISPLACEMENT_LIMIT))
+        {
+            return Err(self.displacement_diverged());
+        }
         self.advance_with(x, [s.contact[0].force, s.contact[1].force], s.time)?;
+        if self.steps.is_multiple_of(HEALTH_CHECK_INTERVAL) {
+            self.check_states()?;
+        }
         Ok(self.latest)
+    }
+
+    /// Checks every state of the track and the vehicle against the health bounds of
+    /// [`crate::limits`]: rail and sleeper displacements within
+    /// [`DISPLACEMENT_LIMIT`], vehicle bodies within [`BODY_DISPLACEMENT_LIMIT`], all
+    /// finite. Run every [`HEALTH_CHECK_INTERVAL`] steps and after the static solve.
+    pub fn check_states(&self) -> Result<()> {
+        if let TrackState::Discrete(t) = &self.track {
+            let m = t.max_abs_displacement();
+            if !within(m, DISPLACEMENT_LIMIT) {
+                return Err(Error::Diverged {
+                    what: "largest rail or sleeper displacement (m)".into(),
+                    value: m,
+                    limit: DISPLACEMENT_LIMIT,
+                    time: self.time(),
+                    cause: self.likely_cause(),
+                });
+            }
+        }
+        if let VehicleState::RollPlane(v) = &self.vehicle {
+            let d = v.displacements();
+            if let Some((i, x)) = d
+                .iter()
+                .enumerate()
+                .find(|(_, x)| !within(**x, BODY_DISPLACEMENT_LIMIT))
+            {
+                return Err(Error::Diverged {
+                    what: format!("vehicle {}", crate::vehicle::BODY_DOFS[i]),
+                    value: *x,
+                    limit: BODY_DISPLACEMENT_LIMIT,
+                    time: self.time(),
+                    cause: self.likely_cause(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The error for a wheel or rail displacement under the wheel beyond the bound.
+    #[cold]
+    #[inline(never)]
+    fn displacement_diverged(&self) -> Error {
+        let s = &self.latest;
+        let names = [
+            ("wheel.left.z (m)", s.wheel_z[0]),
+            ("wheel.right.z (m)", s.wheel_z[1]),
+            ("rail.left.z under the wheel (m)", s.rail_z[0]),
+            ("rail.right.z under the wheel (m)", s.rail_z[1]),
+        ];
+        let (what, value) = names
+            .into_iter()
+            .find(|(_, x)| !within(*x, DISPLACEMENT_LIMIT))
+            .unwrap_or(names[0]);
+        Error::Diverged {
+            what: what.into(),
+            value,
+            limit: DISPLACEMENT_LIMIT,
+            time: s.time,
+            cause: self.likely_cause(),
+        }
+    }
+
+    /// The error for a contact force beyond [`crate::limits::force_limit`].
+    #[cold]
+    #[inline(never)]
+    fn force_diverged(&self, p: [f64; 2], time: f64) -> Error {
+        let i = usize::from(within(p[0], self.force_limit));
+        let side = ["left", "right"][i];
+        Error::Diverged {
+            what: format!("contact.{side}.force (N)"),
+            value: p[i],
+            limit: self.force_limit,
+            time,
+            cause: format!(
+                "{} times the static wheel load {} N; {}",
+                crate::limits::FORCE_LIMIT_FACTOR,
+                num(self.static_load[0].max(self.static_load[1])),
+                self.likely_cause()
+            ),
+        }
+    }
+
+    /// What most likely drove a value beyond the health bounds, in words.
+    fn likely_cause(&self) -> String {
+        let step = match &self.track {
+            TrackState::Discrete(t) => format!(
+                "solver.step = {} s is {:.3} of the critical step {} s, so the explicit \
+                 scheme should be stable: check parameters far from a railway",
+                num(self.dt),
+                self.dt / t.dt_critical(),
+                num(t.dt_critical())
+            ),
+            TrackState::Lumped(_) => "the explicit scheme diverged".into(),
+        };
+        match &self.vehicle {
+            VehicleState::External { wheel_z, .. } => format!(
+                "likely the wheel inputs (wheel.left.z = {} m, wheel.right.z = {} m) press \
+                 the wheel into the rail far beyond a running wheel's overlap; else {step}",
+                num(wheel_z[0]),
+                num(wheel_z[1])
+            ),
+            _ => step,
+        }
+    }
+
+    /// Advances `n` steps of [`Simulation::dt`]. A run whose end would carry the wheel
+    /// off the track is refused with [`Error::OffTrack`] before anything moves; a
+    /// value beyond the health bounds stops it with [`Error::Diverged`].
+    pub fn advance_steps(&mut self, n: u64) -> Result<()> {
+        if let TrackState::Discrete(t) = &self.track {
+            let len = t.params().length();
+            let t_end = self.t0 + (self.k + n) as f64 * self.dt;
+            let end = self.scenario.start_position + self.scenario.speed * t_end;
+            if !(end > 0.0 && end < len) {
+                return Err(Error::OffTrack {
+                    position: end,
+                    length: len,
+                    time: t_end,
+                });
+            }
+        }
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
     }
 
     /// Advances vehicle and track from `t_j` (s) with the contact forces `p` (N) of
     /// the sample at `t_j`, the wheels at position `x` (m).
     #[inline(always)]
     fn advance_with(&mut self, x: f64, p: [f64; 2], time: f64) -> Result<()> {
-        if !(p[0].is_finite() && p[1].is_finite()) {
-            return Err(Error::NonFinite {
-                what: "contact force".into(),
-                time,
-            });
+        let lim = self.force_limit;
+        if !(within(p[0], lim) && within(p[1], lim)) {
+            return Err(self.force_diverged(p, time));
         }
         for i in 0..2 {
             self.max_force[i] = self.max_force[i].max(p[i]);
@@ -572,33 +781,6 @@ impl Simulation {
         self.k = 0;
         self.dt = dt;
         self.cached.set(None);
-        Ok(())
-    }
-
-    /// Advances by a communication step `h` (s): `ceil(h / dt_base)` equal substeps,
-    /// so a step equal to the base step is one engine step, bit for bit. A step whose
-    /// end would carry the wheel off the track is refused before anything moves.
-    pub fn advance(&mut self, h: f64) -> Result<()> {
-        positive("communication step", h, "s")?;
-        if let TrackState::Discrete(t) = &self.track {
-            let len = t.params().length();
-            let end = self.position() + self.scenario.speed * h;
-            if !(end > 0.0 && end < len) {
-                return Err(Error::OffTrack {
-                    position: end,
-                    length: len,
-                    time: self.time() + h,
-                });
-            }
-        }
-        let n = ((h / self.dt_base) * (1.0 - 1e-12)).ceil().max(1.0);
-        let sub = h / n;
-        if sub != self.dt {
-            self.change_dt(sub)?;
-        }
-        for _ in 0..n as u64 {
-            self.step()?;
-        }
         Ok(())
     }
 

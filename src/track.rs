@@ -17,7 +17,8 @@
 //! (the fixed end nodes separate them), with no allocation and no bounds checks, so
 //! the compiler vectorises it.
 
-use crate::error::{Error, Result, non_negative, out_of_range, positive};
+use crate::error::{Error, Result, out_of_range, positive};
+use crate::limits::check;
 use nalgebra::{DMatrix, DVector, Matrix4, SymmetricEigen};
 
 /// Rail cross-section data for the Timoshenko beam.
@@ -61,10 +62,10 @@ impl RailSection {
 
     /// Checks every field.
     pub fn validate(&self) -> Result<()> {
-        positive("track.rail.EI", self.ei, "N m^2")?;
-        positive("track.rail.kAG", self.kag, "N")?;
-        positive("track.rail.mass", self.mass, "kg/m")?;
-        positive("track.rail.rotary_inertia", self.rotary_inertia, "kg m")?;
+        check("track.rail.EI", self.ei)?;
+        check("track.rail.kAG", self.kag)?;
+        check("track.rail.mass", self.mass)?;
+        check("track.rail.rotary_inertia", self.rotary_inertia)?;
         Ok(())
     }
 }
@@ -128,15 +129,15 @@ impl TrackParams {
                 "spans * nodes_per_span <= 1e6",
             ));
         }
-        positive("track.sleeper_spacing", self.sleeper_spacing, "m")?;
-        positive("track.rail_seat_distance", self.rail_seat_distance, "m")?;
+        check("track.sleeper_spacing", self.sleeper_spacing)?;
+        check("track.rail_seat_distance", self.rail_seat_distance)?;
         self.rail.validate()?;
-        non_negative("track.pad.stiffness", self.pad_stiffness, "N/m")?;
-        non_negative("track.pad.damping", self.pad_damping, "N s/m")?;
-        non_negative("track.ballast.stiffness", self.ballast_stiffness, "N/m")?;
-        non_negative("track.ballast.damping", self.ballast_damping, "N s/m")?;
-        positive("track.sleeper.mass", self.sleeper_mass, "kg")?;
-        positive("track.sleeper.inertia", self.sleeper_inertia, "kg m^2")?;
+        check("track.pad.stiffness", self.pad_stiffness)?;
+        check("track.pad.damping", self.pad_damping)?;
+        check("track.ballast.stiffness", self.ballast_stiffness)?;
+        check("track.ballast.damping", self.ballast_damping)?;
+        check("track.sleeper.mass", self.sleeper_mass)?;
+        check("track.sleeper.inertia", self.sleeper_inertia)?;
         Ok(())
     }
 
@@ -957,6 +958,19 @@ impl Track {
     pub fn pad_forces(&self, rail: usize) -> &[f64] {
         let at = rail.min(1) * self.sp;
         &self.pad[at..at + self.ns]
+    }
+
+    /// Largest absolute rail deflection or sleeper bounce displacement at t_j (m); NaN
+    /// if any is NaN. For the health check of the solver (padding slots hold zeros).
+    pub fn max_abs_displacement(&self) -> f64 {
+        let mut m: f64 = 0.0;
+        for &x in self.z.iter().chain(self.zs.iter()) {
+            if x.is_nan() {
+                return f64::NAN;
+            }
+            m = m.max(x.abs());
+        }
+        m
     }
 
     /// Sets every displacement (at t_j and t_(j-1)) and pad force to zero.

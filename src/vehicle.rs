@@ -11,6 +11,7 @@
 //! Roll angles are positive when they raise the right side (MODEL.md).
 
 use crate::error::{Error, Result, non_negative, out_of_range, positive};
+use crate::limits::check;
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 /// Parameters of the roll-plane vehicle (table 4.4 names).
@@ -48,23 +49,23 @@ pub struct RollPlaneParams {
 impl RollPlaneParams {
     /// Checks every parameter.
     pub fn validate(&self) -> Result<()> {
-        non_negative("vehicle.carbody_mass", self.carbody_mass, "kg")?;
-        positive("vehicle.bolster.mass", self.bolster_mass, "kg")?;
-        positive("vehicle.bolster.inertia", self.bolster_inertia, "kg m^2")?;
-        positive("vehicle.sideframe.mass", self.sideframe_mass, "kg")?;
-        positive("vehicle.wheelset.mass", self.wheelset_mass, "kg")?;
-        positive("vehicle.wheelset.inertia", self.wheelset_inertia, "kg m^2")?;
-        positive("vehicle.primary.stiffness", self.primary_stiffness, "N/m")?;
-        non_negative("vehicle.primary.damping", self.primary_damping, "N s/m")?;
-        positive("vehicle.primary.spacing", self.primary_spacing, "m")?;
-        positive(
-            "vehicle.secondary.stiffness",
-            self.secondary_stiffness,
-            "N/m",
-        )?;
-        non_negative("vehicle.secondary.damping", self.secondary_damping, "N s/m")?;
-        positive("vehicle.secondary.spacing", self.secondary_spacing, "m")?;
-        non_negative("gravity", self.gravity, "m/s^2")?;
+        for (name, value) in [
+            ("vehicle.carbody_mass", self.carbody_mass),
+            ("vehicle.bolster.mass", self.bolster_mass),
+            ("vehicle.bolster.inertia", self.bolster_inertia),
+            ("vehicle.sideframe.mass", self.sideframe_mass),
+            ("vehicle.wheelset.mass", self.wheelset_mass),
+            ("vehicle.wheelset.inertia", self.wheelset_inertia),
+            ("vehicle.primary.stiffness", self.primary_stiffness),
+            ("vehicle.primary.damping", self.primary_damping),
+            ("vehicle.primary.spacing", self.primary_spacing),
+            ("vehicle.secondary.stiffness", self.secondary_stiffness),
+            ("vehicle.secondary.damping", self.secondary_damping),
+            ("vehicle.secondary.spacing", self.secondary_spacing),
+            ("gravity", self.gravity),
+        ] {
+            check(name, value)?;
+        }
         Ok(())
     }
 
@@ -177,6 +178,17 @@ impl RollPlaneParams {
                 + self.wheelset_mass)
     }
 }
+
+/// Names of the six degrees of freedom `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`, with
+/// their units, for messages.
+pub const BODY_DOFS: [&str; 6] = [
+    "bolster.z (m)",
+    "bolster.roll (rad)",
+    "sideframe.left.z (m)",
+    "sideframe.right.z (m)",
+    "wheelset.z (m)",
+    "wheelset.roll (rad)",
+];
 
 /// The six-DOF roll-plane vehicle with its central-difference stepper (3.25).
 #[derive(Debug, Clone)]
@@ -346,7 +358,7 @@ impl RollPlaneVehicle {
 
     /// Static equilibrium with the wheels held at `z_wheel = [left, right]` (m): the
     /// wheelset follows, the bolster and side frames are solved from their equations.
-    pub fn set_static(&mut self, z_wheel: [f64; 2]) {
+    pub fn set_static(&mut self, z_wheel: [f64; 2]) -> Result<()> {
         let lw = self.params.primary_spacing;
         let zw = 0.5 * (z_wheel[0] + z_wheel[1]);
         let phw = (z_wheel[1] - z_wheel[0]) / lw;
@@ -358,9 +370,20 @@ impl RollPlaneVehicle {
         let da = kaa
             .lu()
             .solve(&rhs)
-            .expect("suspension stiffness matrix is regular");
+            .filter(|d| d.iter().all(|x| x.is_finite()));
+        let Some(da) = da else {
+            return Err(Error::Unsupported(format!(
+                "static equilibrium of the vehicle: the suspension (vehicle.primary.stiffness = {}, \
+                 vehicle.secondary.stiffness = {}, vehicle.secondary.spacing = {}) does not hold \
+                 the bodies",
+                self.params.primary_stiffness,
+                self.params.secondary_stiffness,
+                self.params.secondary_spacing
+            )));
+        };
         self.d = Vector6::new(da[0], da[1], da[2], da[3], zw, phw);
         self.d_prev = self.d;
+        Ok(())
     }
 
     /// Residual `F - K d` (N, N m) for contact forces `p`: zero in static equilibrium.
@@ -544,7 +567,7 @@ mod tests {
     fn static_state_has_zero_residual() {
         let p = table_4_4();
         let mut v = RollPlaneVehicle::new(p, 45e-6).unwrap();
-        v.set_static([-1e-3, -1.2e-3]);
+        v.set_static([-1e-3, -1.2e-3]).unwrap();
         let w = p.static_wheel_load();
         // Unequal wheel heights and equal loads: the wheelset rolls, nothing accelerates.
         let r = v.static_residual([w, w]);

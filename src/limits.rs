@@ -1,0 +1,183 @@
+//! What a physical run can reach, and what one call may cost.
+//!
+//! * [`PARAMETER_RANGES`]: the physical range of every named parameter. The engine's
+//!   `validate` functions check against it, and the FMUs' variable table
+//!   (`modelDescription/variables.xml`) declares the same `min`/`max` (a unit test in
+//!   `fmu` keeps the two equal), so an FMU refuses a value at `fmi2SetReal` already.
+//!   The ranges bracket every parameter set of the seed (chapter 2, tables 4.1, 4.4,
+//!   5.1, 5.2) and standard-gauge freight and passenger vehicles and track with wide
+//!   margins; they exist so that no value inside them overflows the arithmetic
+//!   (a mass of 1e-300 kg or a stiffness of 1e308 N/m is not a railway).
+//! * The health bounds: a displacement of a decimetre at a rail or a wheel, or a
+//!   contact force of [`FORCE_LIMIT_FACTOR`] times the static wheel load, is reached by
+//!   no physical run (impact forces of wheel flats stay below about six times the
+//!   static load: seed chapter 1; this model gives 2.85 times for the reference flat).
+//!   Reaching one means the scheme diverged or the inputs are not a running wheel, and
+//!   the run stops with an error naming the quantity, the time and the likely cause.
+//! * The work bounds of one FMI call (see [`MAX_NODE_STEPS_PER_CALL`]).
+
+use crate::error::{Error, Result, num};
+
+/// The physical range of one parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// Parameter name, as in the FMUs' variable table.
+    pub name: &'static str,
+    /// Least value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+    /// SI unit, for messages.
+    pub unit: &'static str,
+}
+
+const fn r(name: &'static str, min: f64, max: f64, unit: &'static str) -> Range {
+    Range {
+        name,
+        min,
+        max,
+        unit,
+    }
+}
+
+/// Physical ranges of the parameters, by name (the FMUs' variable names).
+pub const PARAMETER_RANGES: &[Range] = &[
+    r("speed", 0.0, 200.0, "m/s"),
+    r("wheel.radius", 0.05, 2.0, "m"),
+    r("contact.Kw", 0.0, 1e13, "N/m/rad"),
+    r("contact.CH", 0.0, 1e13, "N/m^1.5"),
+    r("track.sleeper_spacing", 0.1, 3.0, "m"),
+    r("track.rail_seat_distance", 0.3, 3.0, "m"),
+    r("track.rail.EI", 1e4, 1e9, "N m^2"),
+    r("track.rail.kAG", 1e6, 1e11, "N"),
+    r("track.rail.mass", 5.0, 500.0, "kg/m"),
+    r("track.rail.rotary_inertia", 1e-4, 100.0, "kg m"),
+    r("track.pad.stiffness", 0.0, 1e11, "N/m"),
+    r("track.pad.damping", 0.0, 1e8, "N s/m"),
+    r("track.ballast.stiffness", 0.0, 1e11, "N/m"),
+    r("track.ballast.damping", 0.0, 1e8, "N s/m"),
+    r("track.sleeper.mass", 10.0, 1e4, "kg"),
+    r("track.sleeper.inertia", 0.1, 1e4, "kg m^2"),
+    r("vehicle.carbody_mass", 0.0, 2e5, "kg"),
+    r("vehicle.bolster.mass", 1.0, 1e5, "kg"),
+    r("vehicle.bolster.inertia", 0.1, 1e5, "kg m^2"),
+    r("vehicle.sideframe.mass", 1.0, 1e5, "kg"),
+    r("vehicle.wheelset.mass", 50.0, 1e5, "kg"),
+    r("vehicle.wheelset.inertia", 1.0, 1e5, "kg m^2"),
+    r("vehicle.primary.stiffness", 1e4, 1e10, "N/m"),
+    r("vehicle.primary.damping", 0.0, 1e7, "N s/m"),
+    r("vehicle.primary.spacing", 0.5, 3.0, "m"),
+    r("vehicle.secondary.stiffness", 1e4, 1e10, "N/m"),
+    r("vehicle.secondary.damping", 0.0, 1e7, "N s/m"),
+    r("vehicle.secondary.spacing", 0.1, 3.0, "m"),
+    r("gravity", 0.0, 100.0, "m/s^2"),
+    r("static_load.left", 0.0, 2e6, "N"),
+    r("static_load.right", 0.0, 2e6, "N"),
+    r("static_wheel_z.left", -0.1, 0.1, "m"),
+    r("static_wheel_z.right", -0.1, 0.1, "m"),
+];
+
+/// The range of parameter `name`, if it has one.
+pub fn range(name: &str) -> Option<&'static Range> {
+    PARAMETER_RANGES.iter().find(|r| r.name == name)
+}
+
+/// Checks `value` against the physical range of parameter `name` (and that it is
+/// finite). A name without a range only has to be finite.
+pub fn check(name: &str, value: f64) -> Result<f64> {
+    match range(name) {
+        Some(r) if !(value >= r.min && value <= r.max) => Err(Error::Parameter {
+            name: name.into(),
+            value,
+            allowed: format!("{} <= {name} <= {} {}", num(r.min), num(r.max), r.unit),
+        }),
+        None if !value.is_finite() => Err(Error::Parameter {
+            name: name.into(),
+            value,
+            allowed: "a finite number".into(),
+        }),
+        _ => Ok(value),
+    }
+}
+
+/// `|x| <= limit`, false for NaN: the health bounds' test.
+#[inline(always)]
+pub fn within(x: f64, limit: f64) -> bool {
+    x.abs() <= limit
+}
+
+/// A contact force above this many static wheel loads is reached by no physical run.
+pub const FORCE_LIMIT_FACTOR: f64 = 20.0;
+/// The static load the force limit is taken from is at least this (N), so an unloaded
+/// wheel pressed onto the rail from outside keeps a physical margin.
+pub const FORCE_LIMIT_MIN_STATIC_LOAD: f64 = 100e3;
+
+/// The largest contact force (N) a physical run reaches with static wheel loads
+/// `static_load` (N).
+pub fn force_limit(static_load: [f64; 2]) -> f64 {
+    FORCE_LIMIT_FACTOR
+        * static_load[0]
+            .max(static_load[1])
+            .max(FORCE_LIMIT_MIN_STATIC_LOAD)
+}
+
+/// Largest displacement of a rail node, sleeper seat or wheel centre (m) a physical run
+/// reaches (static deflections are about 1.5 mm).
+pub const DISPLACEMENT_LIMIT: f64 = 0.1;
+/// Largest displacement of a vehicle body (m) or roll angle (rad) a physical run
+/// reaches (static suspension deflections are some centimetres).
+pub const BODY_DISPLACEMENT_LIMIT: f64 = 1.0;
+
+/// The most track work one FMI call may do: internal steps times rail nodes. About two
+/// seconds on this project's machine (1 to 1.5 ns per rail node and step); 2e9 node
+/// steps are 4.1e6 steps (59 s of simulated time) on the default 30-span, n = 8 track.
+pub const MAX_NODE_STEPS_PER_CALL: f64 = 2e9;
+/// The most vehicle steps one FMI call may do (RollPlaneVehicle; about 2 s).
+pub const MAX_VEHICLE_STEPS_PER_CALL: f64 = 2e7;
+/// The engine checks every state of the track and vehicle for the health bounds every
+/// this many steps (the contact forces, wheel and rail under the wheel every step).
+pub const HEALTH_CHECK_INTERVAL: u64 = 256;
+/// `solver.dt`, when given, must be at least this fraction of the critical step: a
+/// smaller step resolves nothing more and only multiplies the work.
+pub const MIN_DT_FRACTION: f64 = 1e-3;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{Scenario, TrackSpec, VehicleSpec};
+
+    #[test]
+    fn every_seed_parameter_set_is_inside_the_ranges() {
+        for s in [
+            Scenario::table_4_1(),
+            Scenario::table_4_4(),
+            Scenario::table_5_1(),
+            Scenario::table_5_2(),
+        ] {
+            check("speed", s.speed).unwrap();
+            check("wheel.radius", s.wheel_radius).unwrap();
+            check("contact.CH", s.hertz_coefficient).unwrap();
+            check("contact.Kw", s.kw).unwrap();
+            if let TrackSpec::Discrete(t) = s.track {
+                t.validate().unwrap();
+            }
+            if let VehicleSpec::RollPlane(v) = s.vehicle {
+                v.validate().unwrap();
+            }
+        }
+    }
+
+    #[test]
+    fn out_of_range_names_the_parameter_value_and_range() {
+        let e = check("vehicle.primary.stiffness", 1e308).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "parameter `vehicle.primary.stiffness` = 1e308 is out of range: allowed \
+             10000 <= vehicle.primary.stiffness <= 1e10 N/m"
+        );
+        assert!(check("track.rail.mass", 1e-300).is_err());
+        assert!(check("track.rail.mass", f64::NAN).is_err());
+        assert_eq!(check("track.rail.mass", 60.0).unwrap(), 60.0);
+        assert!(check("no.such.name", f64::INFINITY).is_err());
+    }
+}
