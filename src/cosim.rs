@@ -429,7 +429,10 @@ mod tests {
         // bounds), and the left wheel's excursion from rest differs from the
         // fixed-step run's by the first-order error of the step changes.
         assert!(t > 200.0, "{t}");
-        assert!(largest > 1e-3 && worst < 0.1 * largest, "{worst} of {largest}");
+        assert!(
+            largest > 1e-3 && worst < 0.1 * largest,
+            "{worst} of {largest}"
+        );
         println!("largest excursion {largest:e} m, largest difference {worst:e} m");
     }
 }

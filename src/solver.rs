@@ -82,6 +82,9 @@ pub struct Simulation {
     k: u64,
     steps: u64,
     static_load: [f64; 2],
+    /// Critical step of the explicit scheme (s), the contact's stiffness included; NaN
+    /// for the lumped track.
+    critical_step: f64,
     /// Largest contact force a physical run reaches (N) ([`crate::limits::force_limit`]).
     force_limit: f64,
     max_force: [f64; 2],
@@ -164,7 +167,26 @@ fn at_level<R>(level: SimdLevel, f: impl FnOnce() -> R) -> R {
     level.min(SimdLevel::Avx2).run(f)
 }
 
-/// Time step used when the scenario asks for the default (`dt = 0`) (s).
+/// The contact stiffness passed to the track's stability limit is this many times the
+/// perfect wheel's `dP / d delta` at the force limit: a flat in the patch raises it by at
+/// most 2.03 times at equal force, and by 1.46 times at the force limit
+/// (`examples/stability_limit.rs`).
+pub const CONTACT_STIFFNESS_MARGIN: f64 = 2.0;
+
+/// Stiffness `dP / d delta` (N/m) of contact law `law` on a perfect wheel of radius
+/// `radius` (m) at contact force `force` (N), by a central difference about the overlap
+/// that carries it; for the adaptive law it equals `2 K_w alpha_w`.
+pub fn contact_stiffness(law: &ContactLaw, radius: f64, force: f64) -> Result<f64> {
+    let wheel = WheelProfile::perfect(radius)?;
+    let delta = law.overlap_for_force(&wheel, 0.0, force);
+    let e = 1e-6 * delta;
+    let p = |d: f64| law.evaluate(&wheel, 0.0, d).force;
+    Ok((p(delta + e) - p(delta - e)) / (2.0 * e))
+}
+
+/// Time step used when the scenario asks for the default (`dt = 0`) (s), without the
+/// contact's stiffness ([`Simulation::new`] takes it into account; the two agree for
+/// every physical contact: see `docs/VALIDATION.md`).
 pub fn default_dt(scenario: &Scenario) -> f64 {
     match &scenario.track {
         TrackSpec::Discrete(t) => DEFAULT_DT_FRACTION * t.critical_time_step().0,
@@ -186,20 +208,56 @@ impl Simulation {
         non_negative("solver.dt", s.dt, "s")?;
         non_negative("contact.Kw", s.kw, "N/m/rad")?;
         non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
-        let dt = if s.dt == 0.0 { default_dt(s) } else { s.dt };
-        if let TrackSpec::Discrete(p) = &s.track {
-            p.validate()?;
-            let (critical, _) = p.critical_time_step();
-            if dt < MIN_DT_FRACTION * critical {
+        // The contact law first: its stiffness under the largest force a run reaches
+        // enters the stability limit of the track.
+        let static_load = match &s.vehicle {
+            VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
+            VehicleSpec::LumpedWheels(p) => [p.load; 2],
+            VehicleSpec::ConstantLoad(p) => *p,
+            VehicleSpec::External { static_load } => *static_load,
+        };
+        let law = match s.contact_model {
+            ContactModel::Adaptive => {
+                let kw = if s.kw > 0.0 {
+                    s.kw
+                } else {
+                    kw_from_hertz(s.hertz_coefficient, static_load[0].max(1.0), s.wheel_radius)?
+                };
+                ContactLaw::adaptive(kw)?
+            }
+            ContactModel::Hertz => ContactLaw::hertz(s.hertz_coefficient)?,
+        };
+        let critical = match &s.track {
+            TrackSpec::Discrete(p) => {
+                p.validate()?;
+                let kc = contact_stiffness(&law, s.wheel_radius, force_limit(static_load))?;
+                Some(p.critical_time_step_with_contact(CONTACT_STIFFNESS_MARGIN * kc))
+            }
+            TrackSpec::Lumped(_) => None,
+        };
+        let dt = match (s.dt, &critical) {
+            (0.0, Some((c, _))) => DEFAULT_DT_FRACTION * c,
+            (0.0, None) => default_dt(s),
+            (dt, _) => dt,
+        };
+        if let Some((c, limit)) = &critical {
+            if dt > *c {
+                return Err(Error::UnstableTimeStep {
+                    dt,
+                    critical: *c,
+                    limit: limit.clone(),
+                });
+            }
+            if dt < MIN_DT_FRACTION * c {
                 return Err(out_of_range(
                     "solver.dt",
                     dt,
                     format!(
                         "0 (the default, {} s) or {} s <= solver.dt <= {} s (the critical step; \
                          a step below {MIN_DT_FRACTION} of it resolves nothing more)",
-                        num(DEFAULT_DT_FRACTION * critical),
-                        num(MIN_DT_FRACTION * critical),
-                        num(critical)
+                        num(DEFAULT_DT_FRACTION * c),
+                        num(MIN_DT_FRACTION * c),
+                        num(*c)
                     ),
                 ));
             }
@@ -223,7 +281,7 @@ impl Simulation {
             }
             TrackSpec::Lumped(p) => TrackState::Lumped(LumpedTrack::new(*p, dt)?),
         };
-        let (vehicle, static_load) = match &s.vehicle {
+        let (vehicle, _) = match &s.vehicle {
             VehicleSpec::RollPlane(p) => {
                 let v = RollPlaneVehicle::new(*p, dt)?;
                 let w = p.static_wheel_load();
@@ -251,17 +309,6 @@ impl Simulation {
                 )
             }
         };
-        let law = match s.contact_model {
-            ContactModel::Adaptive => {
-                let kw = if s.kw > 0.0 {
-                    s.kw
-                } else {
-                    kw_from_hertz(s.hertz_coefficient, static_load[0].max(1.0), s.wheel_radius)?
-                };
-                ContactLaw::adaptive(kw)?
-            }
-            ContactModel::Hertz => ContactLaw::hertz(s.hertz_coefficient)?,
-        };
         let mut sim = Simulation {
             scenario: s.clone(),
             track,
@@ -273,6 +320,7 @@ impl Simulation {
             k: 0,
             steps: 0,
             static_load,
+            critical_step: critical.map_or(f64::NAN, |c| c.0),
             force_limit: force_limit(static_load),
             max_force: [f64::NEG_INFINITY; 2],
             min_force: [f64::INFINITY; 2],
@@ -363,6 +411,13 @@ impl Simulation {
             }
             _ => None,
         }
+    }
+
+    /// Critical step of the explicit scheme (s), with the contact stiffness under the
+    /// largest force a run reaches ([`crate::track::TrackParams::critical_time_step_with_contact`]);
+    /// NaN for the lumped track.
+    pub fn critical_step(&self) -> f64 {
+        self.critical_step
     }
 
     /// Static wheel loads (N).

@@ -586,10 +586,7 @@ impl Instance {
             _ => {
                 let s = self.scenario();
                 let sim = Simulation::new(&s)?;
-                let critical_step = match &s.track {
-                    TrackSpec::Discrete(t) => t.critical_time_step().0,
-                    TrackSpec::Lumped(_) => f64::NAN,
-                };
+                let critical_step = sim.critical_step();
                 let published = Published {
                     static_load: sim.static_load(),
                     static_wheel_z: sim.wheel_z(),
@@ -736,15 +733,19 @@ impl Instance {
             Some(Model::Sim(sim)) if needs_model => Some(sim.sample()),
             _ => None,
         };
+        let lim = crate::limits::force_limit(self.published.static_load);
         for (o, &r) in out.iter_mut().zip(vrs) {
             let s = self.known_spec(r);
-            *o = match s.causality {
-                Causality::Parameter | Causality::Input => self.values[s.vr as usize],
-                _ => self.computed(s.vr, sample.as_ref()),
-            };
             let computed = !matches!(s.causality, Causality::Parameter | Causality::Input);
-            let lim = crate::limits::force_limit(self.published.static_load);
-            if computed && s.unit == "N" && !crate::limits::within(*o, lim) && o.is_finite() {
+            *o = if computed {
+                self.computed(s.vr, sample.as_ref())
+            } else {
+                self.values[s.vr as usize]
+            };
+            if crate::limits::within(*o, lim) {
+                continue;
+            }
+            if computed && s.unit == "N" && o.is_finite() {
                 let (name, x) = (s.name, *o);
                 return self.refuse(
                     Status::Error,
@@ -1018,10 +1019,17 @@ impl Instance {
         }
         // The rounding of the master's clock: a few units in the last place of the time.
         let clock = 16.0 * f64::EPSILON * t.abs().max(end.abs());
-        let work = match &self.model {
+        // Steps to take: to the grid point nearest `end` (track), or the vehicle's count.
+        let n = match &self.model {
             Some(Model::Sim(sim)) => {
                 let target = ((end - self.start_time) / sim.dt()).round().max(0.0);
-                let n = (target - sim.steps() as f64).max(0.0);
+                (target - sim.steps() as f64).max(0.0)
+            }
+            Some(Model::Vehicle(u)) => u.steps_for(h, clock),
+            None => 0.0,
+        };
+        let work = match &self.model {
+            Some(Model::Sim(sim)) => {
                 let cost = n * sim.rail_nodes() as f64;
                 (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
                     format!(
@@ -1033,16 +1041,13 @@ impl Instance {
                     )
                 })
             }
-            Some(Model::Vehicle(u)) => {
-                let n = u.steps_for(h, clock);
-                (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
-                    format!(
-                        "{n} steps of solver.step = {} s; the most one call may do is \
+            Some(Model::Vehicle(u)) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
+                format!(
+                    "{n} steps of solver.step = {} s; the most one call may do is \
                          {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
-                        u.dt_base()
-                    )
-                })
-            }
+                    u.dt_base()
+                )
+            }),
             None => None,
         };
         if let Some(w) = work {
@@ -1055,11 +1060,7 @@ impl Instance {
             );
         }
         let r = match &mut self.model {
-            Some(Model::Sim(sim)) => {
-                let target = ((end - self.start_time) / sim.dt()).round().max(0.0);
-                let n = (target - sim.steps() as f64).max(0.0);
-                sim.advance_steps(n as u64)
-            }
+            Some(Model::Sim(sim)) => sim.advance_steps(n as u64),
             Some(Model::Vehicle(u)) => u.advance(h, clock),
             None => Err(Error::Unsupported("stepping before initialisation".into())),
         };
