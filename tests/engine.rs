@@ -287,7 +287,10 @@ fn the_contact_does_not_lower_the_critical_step_of_a_physical_run() {
     // reaches (20 x static, twice the perfect wheel's stiffness) is the plain limit bit
     // for bit, at the seed grid and at the default grid (docs/VALIDATION.md, section 3);
     // the seed's 45 us is 0.972 of it at n = 2.
-    for s in [seed_grid(Scenario::table_4_4_flat()), Scenario::table_4_4_flat()] {
+    for s in [
+        seed_grid(Scenario::table_4_4_flat()),
+        Scenario::table_4_4_flat(),
+    ] {
         let TrackSpec::Discrete(p) = s.track else {
             unreachable!()
         };

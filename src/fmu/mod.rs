@@ -1740,4 +1740,23 @@ mod tests {
         i.exit_initialization().unwrap();
         i.do_step(0.0, 1e-4).unwrap();
     }
+
+    #[test]
+    fn an_unreachable_stop_time_is_named_at_initialisation() {
+        let (mut i, log) = instance(Kind::CoupledSystem);
+        i.setup_experiment(0.0, Some(2.0)).unwrap();
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        let log = log.lock().unwrap();
+        assert_eq!(log.len(), 1);
+        // 30 spans of 0.685 m from 1.37 m at 70 km/h: the end at 0.986 s; 2 s needs
+        // 1.37 + 38.9 m of track, 59 spans, plus the two kept clear of the end.
+        assert!(
+            log[0].contains("stopTime = 2 s cannot be reached"),
+            "{}",
+            log[0]
+        );
+        assert!(log[0].contains("t = 0.986"), "{}", log[0]);
+        assert!(log[0].contains("track.spans >= 61"), "{}", log[0]);
+    }
 }
