@@ -102,7 +102,7 @@ def test_header_compiles_against_official_fmi2Functions_h(tmp_path):
 
 
 def test_shared_library_exports_every_fmi2_cs_function(paths):
-    lib = glob.glob(os.path.join(wf.ROOT, "target", "release", "libwheelflat.so"))[0]
+    lib = glob.glob(os.path.join(wf.TARGET_DIR, "release", "libwheelflat.so"))[0]
     out = subprocess.run(["nm", "-D", "--defined-only", lib], capture_output=True, text=True, check=True).stdout
     names = {line.split()[-1] for line in out.splitlines() if line.strip()}
     assert set(FMI2_CS_FUNCTIONS) <= names
@@ -135,7 +135,7 @@ def test_pair_at_comm_step_dt_equals_coupled_system(paths):
 
 def test_coupled_system_reproduces_the_runner(paths, tmp_path):
     csv = tmp_path / "runner.csv"
-    subprocess.run([os.path.join(wf.ROOT, "target", "release", "wheelflat"), "--duration", "0.1",
+    subprocess.run([os.path.join(wf.TARGET_DIR, "release", "wheelflat"), "--duration", "0.1",
                     "--output", str(csv)], check=True, capture_output=True, cwd=wf.ROOT)
     runner = np.genfromtxt(csv, delimiter=",", names=True)
     u = initialised(paths, "CoupledSystem")
