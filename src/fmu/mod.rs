@@ -1215,6 +1215,38 @@ impl Instance {
         }
     }
 
+    /// The numbers of a serialized state are what an instance can hold: a finite clock
+    /// from 0 on, finite calculated values and model state, parameters and inputs
+    /// inside their ranges (as fmi2SetReal would take them).
+    fn check_stored(
+        &self,
+        time: f64,
+        pubs: &[f64],
+        values: &[f64],
+        state: &[f64],
+    ) -> std::result::Result<(), String> {
+        if !(time.is_finite() && time >= 0.0) {
+            return Err(format!("stored time {time} s is not finite and >= 0"));
+        }
+        if let Some(x) = pubs.iter().find(|x| !x.is_finite()) {
+            return Err(format!("a stored calculated parameter is {x}"));
+        }
+        for v in self.kind.table().vars {
+            let x = values[v.vr as usize];
+            let known = matches!(v.causality, Causality::Parameter | Causality::Input);
+            if known && !(x.is_finite() && x >= v.min && x <= v.max) {
+                return Err(format!(
+                    "stored `{}` = {x} is out of range (finite, {} to {})",
+                    v.name, v.min, v.max
+                ));
+            }
+        }
+        if let Some(k) = state.iter().position(|x| !x.is_finite()) {
+            return Err(format!("model state [{k}] = {} is not finite", state[k]));
+        }
+        Ok(())
+    }
+
     fn decode(&mut self, bytes: &[u8]) -> std::result::Result<Snapshot, String> {
         let mut r = Cursor { b: bytes, at: 0 };
         if r.take(MAGIC.len())? != MAGIC {
@@ -1258,6 +1290,7 @@ impl Instance {
         if r.at != bytes.len() {
             return Err(format!("{} trailing bytes", bytes.len() - r.at));
         }
+        self.check_stored(time, &pubs, &values, &state)?;
         let model = if has_model {
             // Build with the stored parameters on a scratch instance, then overwrite
             // the dynamic state.
@@ -1507,6 +1540,40 @@ mod tests {
         i.reset().unwrap();
         assert!(!i.terminated_by_model());
         assert_eq!(i.phase(), Phase::Instantiated);
+    }
+
+    #[test]
+    fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
+        let (mut i, _) = instance(Kind::RollPlaneVehicle);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 1e-3).unwrap();
+        let s = i.get_state().unwrap();
+        let b = i.serialize(&s).unwrap();
+        assert!(i.deserialize(&b).is_ok());
+        let put = |at: usize, x: f64| {
+            let mut c = b.clone();
+            c[at..at + 8].copy_from_slice(&x.to_le_bytes());
+            c
+        };
+        let guid = i.kind.table().guid.len();
+        let time_at = MAGIC.len() + 8 + guid + 3;
+        let values_at = time_at + 8 * 8 + 8;
+        for (at, x, why) in [
+            (b.len() - 8, f64::NAN, "model state"),
+            (b.len() - 8, f64::INFINITY, "model state"),
+            (time_at, -1.0, "stored time"),
+            (time_at + 8, f64::NAN, "calculated parameter"),
+            (values_at + 8 * vr::SPEED as usize, -5.0, "`speed` = -5"),
+            (
+                values_at + 8 * vr::GRAVITY as usize,
+                f64::NAN,
+                "`gravity` = NaN",
+            ),
+        ] {
+            let e = i.deserialize(&put(at, x)).unwrap_err();
+            assert!(e.message.contains(why), "{why}: {}", e.message);
+        }
     }
 
     #[test]
