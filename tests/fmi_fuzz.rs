@@ -17,6 +17,8 @@
 //!   0.05 under valgrind);
 //! - `WHEELFLAT_FUZZ_SEQUENCE=<n>`: run only sequence n (to replay a failure);
 //! - `WHEELFLAT_FUZZ_TRACE=1`: print every call before it is made;
+//! - `WHEELFLAT_FUZZ_STOP_AT=<n>`: print the variables of every instance before call
+//!   n of the sequence, and stop;
 //! - `WHEELFLAT_FUZZ_KNOWN_FAULTS=all` (or names: `SubnormalStep,TinySolverDt`): also
 //!   generate the inputs of those [`KNOWN_ENGINE_FAULTS`].
 
@@ -65,6 +67,11 @@ enum Fault {
     /// mass, 5e-324 masses) give NaN/inf outputs with fmi2OK, or a huge track
     /// (`track.spans` * `track.nodes_per_span` in the millions) takes minutes and GBs.
     ExtremeParameters,
+    /// A serialized FMU state whose model state holds finite numbers of extreme
+    /// magnitude (1e300, f64::MAX, 5e-324 in displacements, velocities, the step
+    /// counter, ...) is accepted by fmi2DeSerializeFMUstate and then gives NaN/inf
+    /// outputs with fmi2OK (non-finite numbers are refused).
+    ExtremeState,
 }
 
 /// The engine faults the generator avoids (unless `WHEELFLAT_FUZZ_KNOWN_FAULTS=1`), with
@@ -75,6 +82,7 @@ const KNOWN_ENGINE_FAULTS: &[Fault] = &[
     Fault::HugeStep,
     Fault::TinySolverDt,
     Fault::ExtremeParameters,
+    Fault::ExtremeState,
 ];
 
 /// `WHEELFLAT_FUZZ_TRACE=1`: every call printed before it is made.
@@ -582,6 +590,25 @@ impl World {
                 b[k] = b[k].wrapping_add(rng.random_range(1..=255u8) as fmi2Byte);
             }
             2 => b.extend_from_slice(&[0, 1, 2]),
+            3 if b.len() > 40 => {
+                // A number of the body (clock, calculated values, variables, model
+                // state, or a length) replaced, on the grid of 8-byte fields after the
+                // GUID and the three flag bytes.
+                let guid_len = u64::from_le_bytes(std::array::from_fn(|k| b[22 + k] as u8));
+                let first = 22 + 8 + guid_len as usize + 3;
+                if first + 8 <= b.len() {
+                    let j = rng.random_range(0..(b.len() - first) / 8);
+                    let x = if avoided(Fault::ExtremeState) {
+                        NASTY[rng.random_range(0..3)]
+                    } else {
+                        NASTY[rng.random_range(0..NASTY.len())]
+                    };
+                    let at = first + 8 * j;
+                    for (o, v) in b[at..at + 8].iter_mut().zip(x.to_le_bytes()) {
+                        *o = v as fmi2Byte;
+                    }
+                }
+            }
             _ => {}
         }
         b
@@ -589,6 +616,13 @@ impl World {
 
     /// One random call.
     fn one(&mut self, stats: &Stats) {
+        if std::env::var("WHEELFLAT_FUZZ_STOP_AT")
+            .ok()
+            .and_then(|s| s.parse::<usize>().ok())
+            == Some(self.calls)
+        {
+            self.dump();
+        }
         if self.slots.is_empty() {
             self.instantiate(true);
             return;
@@ -1204,6 +1238,31 @@ impl World {
             }
             Call::Instantiate | Call::FreeInstance => unreachable!(),
         }
+    }
+
+    /// Prints every Real variable of every instance and stops (`WHEELFLAT_FUZZ_STOP_AT`).
+    fn dump(&self) -> ! {
+        for s in &self.slots {
+            let vars: Vec<&VarSpec> = s
+                .table
+                .vars
+                .iter()
+                .filter(|v| v.ty == VarType::Real)
+                .collect();
+            let vrs: Vec<u32> = vars.iter().map(|v| v.vr).collect();
+            let mut x = vec![0.0; vrs.len()];
+            let st = unsafe { fmi2GetReal(s.c, vrs.as_ptr(), vrs.len(), x.as_mut_ptr()) };
+            eprintln!(
+                "{} ({}), fmi2GetReal -> {st}: {}",
+                s.name,
+                s.table.model_identifier,
+                s.log.last()
+            );
+            for (v, x) in vars.iter().zip(&x) {
+                eprintln!("    {} = {x:?}", v.name);
+            }
+        }
+        self.fail(format!("stopped before call {}", self.calls));
     }
 
     /// After a state was set: the communication time and phase from the instance.
