@@ -1,7 +1,9 @@
 //! The C boundary: every FMI 2.0 co-simulation function, exported unmangled. Each one
-//! checks its pointers, converts arguments and forwards to [`super::Instance`] inside
-//! `catch_unwind`, so no panic crosses into the master. cbindgen writes the C header of
-//! this file (`build.rs`); a test compiles it against the official `fmi2Functions.h`.
+//! claims the instance (a busy flag refuses a second thread), checks the state table
+//! ([`super::CALLS`]), its pointers and arguments, and forwards to [`super::Instance`]
+//! inside `catch_unwind`, so no panic crosses into the master. FMU states are owned by
+//! the instance that handed them out. cbindgen writes the C header of this file
+//! (`build.rs`); a test compiles it against the official `fmi2Functions.h`.
 
 #![allow(non_camel_case_types, non_snake_case, clippy::missing_safety_doc)]
 
@@ -525,20 +527,14 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
     }
     // The busy flag stays set: no call can start on the instance being freed.
     let _ = catch_unwind(AssertUnwindSafe(|| {
-        let comp = unsafe { Box::from_raw(c as *mut Component) };
-        comp.inner_log_call();
-        drop(comp)
-    }));
-}
-
-impl Component {
-    fn inner_log_call(&self) {
-        let inner = unsafe { &mut *self.inner.get() };
+        let mut comp = unsafe { Box::from_raw(c as *mut Component) };
+        let inner = comp.inner.get_mut();
         let n = inner.states.len();
         inner
             .inst
             .log_call(|| format!("fmi2FreeInstance() ({n} FMU states freed with it)"));
-    }
+        drop(comp)
+    }));
 }
 
 /// `fmi2SetupExperiment`.

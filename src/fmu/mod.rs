@@ -520,9 +520,19 @@ impl Instance {
     /// refuses it as unsupported). The message names the function, the phase, where
     /// the function is allowed and, after a failed step or an internal error, why the
     /// instance is there.
+    #[inline]
     pub fn check(&mut self, call: Call) -> FmiResult {
+        match call.allowed() {
+            Allowed::NoInstance => Ok(()),
+            Allowed::In(phases) if phases.contains(&self.phase()) => Ok(()),
+            _ => self.refuse_call(call),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_call(&mut self, call: Call) -> FmiResult {
         let phases = match call.allowed() {
-            Allowed::NoInstance => return Ok(()),
             Allowed::Unsupported(why) => {
                 return self.refuse(
                     Status::Error,
@@ -530,11 +540,9 @@ impl Instance {
                 );
             }
             Allowed::In(p) => p,
+            Allowed::NoInstance => return Ok(()),
         };
         let phase = self.phase();
-        if phases.contains(&phase) {
-            return Ok(());
-        }
         let names: Vec<String> = phases.iter().map(|p| format!("{p:?}")).collect();
         let why = match phase {
             Phase::StepFailed if self.ended => format!(
@@ -562,12 +570,22 @@ impl Instance {
         )
     }
 
-    /// The state check of `call` by its C name: the table [`CALLS`] decides. `_allowed`
-    /// is no longer read (the table is the one list); it stays until the callers are
-    /// changed to [`Instance::check`].
-    fn require(&mut self, call: &str, _allowed: &[Phase]) -> FmiResult {
+    /// The state check of `call` by its C name, for callers that still pass their own
+    /// list: `allowed` must be the table's entry (checked in debug builds); a refusal
+    /// comes from [`Instance::check`], with the table's message. New code calls
+    /// [`Instance::check`] with the [`Call`].
+    #[inline]
+    fn require(&mut self, call: &str, allowed: &[Phase]) -> FmiResult {
+        debug_assert!(
+            Call::from_name(call)
+                .is_some_and(|c| matches!(c.allowed(), Allowed::In(p) if p == allowed)),
+            "{call}: the phases {allowed:?} are not the table's"
+        );
+        if allowed.contains(&self.phase()) {
+            return Ok(());
+        }
         match Call::from_name(call) {
-            Some(c) => self.check(c),
+            Some(c) => self.refuse_call(c),
             None => self.refuse(
                 Status::Error,
                 format!("{call}: not an FMI 2.0 co-simulation function"),
