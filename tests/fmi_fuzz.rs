@@ -767,11 +767,10 @@ impl World {
                     0 | 1 => rng.random_range(0.001..2.0),
                     _ => 1.0,
                 };
-                let r = run!(
+                run!(
                     format!("fmi2SetupExperiment({td}, 1e-6, {start:?}, {sd}, {stop:?})"),
                     fmi2SetupExperiment(c, td, 1e-6, start, sd, stop)
-                );
-                r
+                )
             }
             Call::EnterInitializationMode => {
                 run!(
@@ -830,14 +829,14 @@ impl World {
                             out.as_mut_ptr()
                         };
                         let r = run!(desc, fmi2GetReal(c, vp, n, op));
-                        if r.0 == 0 {
-                            if let Some(k) = out.iter().position(|x| !x.is_finite()) {
-                                let v = spec(table, vrs[k]).map_or("?", |v| v.name);
-                                self.fail(format!(
-                                    "{}: fmi2GetReal returned fmi2OK with `{v}` = {}",
-                                    r.1, out[k]
-                                ));
-                            }
+                        if r.0 == 0
+                            && let Some(k) = out.iter().position(|x| !x.is_finite())
+                        {
+                            let v = spec(table, vrs[k]).map_or("?", |v| v.name);
+                            self.fail(format!(
+                                "{}: fmi2GetReal returned fmi2OK with `{v}` = {}",
+                                r.1, out[k]
+                            ));
                         }
                         r
                     }
@@ -1553,14 +1552,14 @@ fn random_call_sequences_keep_the_fmi_contract() {
     while workers.iter().any(|w| !w.is_finished()) {
         std::thread::sleep(Duration::from_millis(50));
         for b in &beats {
-            if let Some((desc, since)) = b.lock().unwrap().as_ref() {
-                if since.elapsed() > CALL_LIMIT {
-                    panic!(
-                        "a call did not return within {CALL_LIMIT:?}: {desc} (seed {seed}; \
-                         set WHEELFLAT_FUZZ_SEED={seed} and find the sequence with \
-                         WHEELFLAT_FUZZ_SEQUENCE)"
-                    );
-                }
+            if let Some((desc, since)) = b.lock().unwrap().as_ref()
+                && since.elapsed() > CALL_LIMIT
+            {
+                panic!(
+                    "a call did not return within {CALL_LIMIT:?}: {desc} (seed {seed}; replay \
+                     with WHEELFLAT_FUZZ_SEED={seed} WHEELFLAT_FUZZ_SEQUENCE=<the sequence> \
+                     WHEELFLAT_FUZZ_TRACE=1)"
+                );
             }
         }
     }

@@ -84,12 +84,21 @@ unsafe extern "C" fn record(
 type Plain =
     unsafe extern "C" fn(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String);
 
+type Variadic = unsafe extern "C" fn(
+    fmi2ComponentEnvironment,
+    fmi2String,
+    fmi2Status,
+    fmi2String,
+    fmi2String,
+    ...
+);
+
 /// Callbacks that record into `log`.
 pub fn callbacks(log: &Log) -> fmi2CallbackFunctions {
     let f: Plain = record;
     fmi2CallbackFunctions {
         // SAFETY: see `record`.
-        logger: Some(unsafe { std::mem::transmute::<Plain, _>(f) }),
+        logger: Some(unsafe { std::mem::transmute::<Plain, Variadic>(f) }),
         allocateMemory: None,
         freeMemory: None,
         stepFinished: None,
