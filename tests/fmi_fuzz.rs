@@ -385,6 +385,19 @@ struct Stats {
     per_call: [[AtomicUsize; 2]; 34],
 }
 
+impl Stats {
+    fn count(&self, call: Call, status: c_int) {
+        self.calls.fetch_add(1, Ordering::Relaxed);
+        self.per_call[call as usize][0].fetch_add(1, Ordering::Relaxed);
+        if status == 0 {
+            self.per_call[call as usize][1].fetch_add(1, Ordering::Relaxed);
+            self.ok.fetch_add(1, Ordering::Relaxed);
+        } else {
+            self.refused.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+}
+
 impl Default for Stats {
     fn default() -> Stats {
         Stats {
@@ -636,7 +649,8 @@ impl World {
         };
         if call == Call::Instantiate {
             if self.slots.len() < MAX_INSTANCES {
-                self.instantiate(false);
+                let made = self.instantiate(false).is_some();
+                stats.count(call, if made { 0 } else { 3 });
             }
             return;
         }
@@ -651,6 +665,7 @@ impl World {
                 for p in s.states {
                     self.freed_states.push(p);
                 }
+                stats.count(call, 0);
             }
             return;
         }
@@ -669,14 +684,7 @@ impl World {
         if !null_component {
             self.follow(i, call, status);
         }
-        stats.calls.fetch_add(1, Ordering::Relaxed);
-        stats.per_call[call as usize][0].fetch_add(1, Ordering::Relaxed);
-        if status == 0 {
-            stats.per_call[call as usize][1].fetch_add(1, Ordering::Relaxed);
-            stats.ok.fetch_add(1, Ordering::Relaxed);
-        } else {
-            stats.refused.fetch_add(1, Ordering::Relaxed);
-        }
+        stats.count(call, status);
         stats
             .slowest_us
             .fetch_max(d.as_micros() as usize, Ordering::Relaxed);
