@@ -18,6 +18,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV = os.path.join(ROOT, ".venv")
 REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
 FMU_DIR = os.path.join(ROOT, "fmu")
+# Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
+TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
 
 
 def venv_python():
@@ -49,7 +51,7 @@ def ensure_venv():
 def build_fmus():
     """Builds the shared library and packs fmu/*.fmu (cargo, release profile)."""
     subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "build_fmus"], cwd=ROOT)
-    subprocess.check_call([os.path.join(ROOT, "target", "release", "build_fmus"), FMU_DIR], cwd=ROOT,
+    subprocess.check_call([os.path.join(TARGET_DIR, "release", "build_fmus"), FMU_DIR], cwd=ROOT,
                           stdout=subprocess.DEVNULL)
     return {name: os.path.join(FMU_DIR, name + ".fmu") for name in ("TrackContact", "RollPlaneVehicle", "CoupledSystem")}
 
@@ -90,10 +92,13 @@ class Unit:
             else:
                 self.fmu.setReal([self.vr[name]], [float(value)])
 
-    def close(self):
+    def close(self, terminate=True):
+        """Terminates (FMI 2.0 allows it after stepping only: pass terminate=False in
+        the other states) and frees the instance."""
         import shutil
         try:
-            self.fmu.terminate()
+            if terminate:
+                self.fmu.terminate()
         finally:
             self.fmu.freeInstance()
             if self.owns_dir:
@@ -115,8 +120,8 @@ def track_step(paths, track_params=None):
         u.fmu.enterInitializationMode()
         return u.get("solver.step")[0]
     finally:
-        u.fmu.terminate()
-        u.close()
+        # Still in initialization mode, where fmi2Terminate is not allowed.
+        u.close(terminate=False)
 
 
 def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):

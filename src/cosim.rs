@@ -195,10 +195,13 @@ impl VehicleUnit {
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
         let d = self.vehicle.displacements();
+        let d_prev = self.vehicle.previous_displacements();
         let wheels = self.vehicle.wheel_z();
         let bad = d
             .iter()
+            .chain(d_prev.iter())
             .enumerate()
+            .map(|(i, x)| (i % 6, x))
             .map(|(i, &x)| {
                 (
                     crate::vehicle::BODY_DOFS[i].to_string(),
@@ -264,13 +267,38 @@ impl VehicleUnit {
                 "21 values",
             ));
         }
+        let count = |x: f64| (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0;
+        if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1])) {
+            return Err(out_of_range(
+                "state: clock",
+                v[0],
+                "t0 finite and >= 0 s, step count a whole number in [0, 2^53)",
+            ));
+        }
+        for &f in &v[2..8] {
+            if !within(f, 1e7) {
+                return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
+            }
+        }
+        let dt = v[8];
+        if !(dt >= 1e-6 * self.dt_base && dt <= self.dt_base) {
+            return Err(out_of_range(
+                "state: step",
+                dt,
+                format!(
+                    "{} s <= dt <= {} s",
+                    num(1e-6 * self.dt_base),
+                    num(self.dt_base)
+                ),
+            ));
+        }
         self.vehicle.set_state_vector(&v[8..])?;
         self.t0 = v[0];
         self.k = v[1] as u64;
         self.force = [v[2], v[3]];
         self.max_force = [v[4], v[5]];
         self.min_force = [v[6], v[7]];
-        Ok(())
+        self.check_states()
     }
 }
 

@@ -677,7 +677,9 @@ impl Simulation {
             let d = v.displacements();
             if let Some((i, x)) = d
                 .iter()
+                .chain(v.previous_displacements().iter())
                 .enumerate()
+                .map(|(i, x)| (i % 6, x))
                 .find(|(_, x)| !within(**x, BODY_DISPLACEMENT_LIMIT))
             {
                 return Err(Error::Diverged {
@@ -879,8 +881,29 @@ impl Simulation {
     }
 
     /// Restores a state written by [`Simulation::state_vector`] of a simulation built
-    /// from the same scenario.
+    /// from the same scenario. Refused: a wrong length, a step outside what
+    /// [`Simulation::new`] accepts, a clock or step count that is not a whole number
+    /// below 2^53, and a state beyond the health bounds ([`Simulation::check_health`]),
+    /// which then stays in the simulation: rebuild it.
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if let (Some(&dt), TrackState::Discrete(_)) = (v.first(), &self.track) {
+            let c = self.critical_step;
+            if !(dt >= MIN_DT_FRACTION * c && dt <= c) {
+                return Err(out_of_range(
+                    "state: step",
+                    dt,
+                    format!("{} s <= dt <= {} s", num(MIN_DT_FRACTION * c), num(c)),
+                ));
+            }
+        }
+        let count = |x: f64| (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0;
+        if v.len() >= 4 && !(v[1].is_finite() && v[1] >= 0.0 && count(v[2]) && count(v[3])) {
+            return Err(out_of_range(
+                "state: clock",
+                v[1],
+                "t0 finite and >= 0 s, step counts whole numbers in [0, 2^53)",
+            ));
+        }
         let nt = match &self.track {
             TrackState::Discrete(t) => t.state_len(),
             TrackState::Lumped(_) => return Err(Self::no_state()),
@@ -922,6 +945,62 @@ impl Simulation {
         self.max_force = [v[4], v[5]];
         self.min_force = [v[6], v[7]];
         self.cached.set(None);
+        self.check_health()
+    }
+
+    /// [`Simulation::check_states`], and the sample at the current time: wheel and rail
+    /// under the wheel within [`DISPLACEMENT_LIMIT`], contact forces within the force
+    /// limit, the force extremes finite.
+    pub fn check_health(&self) -> Result<()> {
+        self.check_states()?;
+        let s = self.sample();
+        let lim = self.force_limit;
+        for (what, x, limit) in [
+            ("wheel.left.z (m)", s.wheel_z[0], DISPLACEMENT_LIMIT),
+            ("wheel.right.z (m)", s.wheel_z[1], DISPLACEMENT_LIMIT),
+            (
+                "rail.left.z under the wheel (m)",
+                s.rail_z[0],
+                DISPLACEMENT_LIMIT,
+            ),
+            (
+                "rail.right.z under the wheel (m)",
+                s.rail_z[1],
+                DISPLACEMENT_LIMIT,
+            ),
+            ("contact.left.force (N)", s.contact[0].force, lim),
+            ("contact.right.force (N)", s.contact[1].force, lim),
+            (
+                "contact.left.max_force (N)",
+                self.max_force[0].max(0.0),
+                lim,
+            ),
+            (
+                "contact.right.max_force (N)",
+                self.max_force[1].max(0.0),
+                lim,
+            ),
+            (
+                "contact.left.min_force (N)",
+                self.min_force[0].min(0.0),
+                lim,
+            ),
+            (
+                "contact.right.min_force (N)",
+                self.min_force[1].min(0.0),
+                lim,
+            ),
+        ] {
+            if !within(x, limit) {
+                return Err(Error::Diverged {
+                    what: what.into(),
+                    value: x,
+                    limit,
+                    time: s.time,
+                    cause: self.likely_cause(),
+                });
+            }
+        }
         Ok(())
     }
 

@@ -302,6 +302,11 @@ impl RollPlaneVehicle {
         &self.d
     }
 
+    /// Displacements at t_(j-1) (m, rad).
+    pub fn previous_displacements(&self) -> &Vector6<f64> {
+        &self.d_prev
+    }
+
     /// Velocities at t_j by backward difference (m/s, rad/s).
     pub fn velocities(&self) -> Vector6<f64> {
         (self.d - self.d_prev) / self.dt

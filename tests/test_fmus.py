@@ -102,7 +102,7 @@ def test_header_compiles_against_official_fmi2Functions_h(tmp_path):
 
 
 def test_shared_library_exports_every_fmi2_cs_function(paths):
-    lib = glob.glob(os.path.join(wf.ROOT, "target", "release", "libwheelflat.so"))[0]
+    lib = glob.glob(os.path.join(wf.TARGET_DIR, "release", "libwheelflat.so"))[0]
     out = subprocess.run(["nm", "-D", "--defined-only", lib], capture_output=True, text=True, check=True).stdout
     names = {line.split()[-1] for line in out.splitlines() if line.strip()}
     assert set(FMI2_CS_FUNCTIONS) <= names
@@ -135,7 +135,7 @@ def test_pair_at_comm_step_dt_equals_coupled_system(paths):
 
 def test_coupled_system_reproduces_the_runner(paths, tmp_path):
     csv = tmp_path / "runner.csv"
-    subprocess.run([os.path.join(wf.ROOT, "target", "release", "wheelflat"), "--duration", "0.1",
+    subprocess.run([os.path.join(wf.TARGET_DIR, "release", "wheelflat"), "--duration", "0.1",
                     "--output", str(csv)], check=True, capture_output=True, cwd=wf.ROOT)
     runner = np.genfromtxt(csv, delimiter=",", names=True)
     u = initialised(paths, "CoupledSystem")
@@ -348,7 +348,78 @@ def test_step_off_the_track_is_discarded_and_terminates(paths):
     k = round(0.01 / dt)
     assert abs(k * dt - 0.01) <= 0.5 * dt
     assert u.get("position")[0] == pytest.approx(1.37 + k * dt * 70 / 3.6, rel=1e-12)
+    # stepFailed (FMI 2.0): no further step, each refusal says why
+    for h in (1e-5, 5.0):
+        assert f.dll.fmi2DoStep(f.component, ctypes.c_double(0.01), ctypes.c_double(h), 1) == 3
+        assert log.last()[2].startswith("fmi2DoStep is not allowed in state StepFailed")
+        assert "the model ended the run at t = 0.01 s" in log.last()[2] and "fmi2Reset" in log.last()[2]
+    assert u.get("position")[0] == pytest.approx(1.37 + k * dt * 70 / 3.6, rel=1e-12)
+    u.close()  # fmi2Terminate is allowed after the failed step
+
+
+def test_terminate_and_status_follow_the_state_table(paths):
+    log = Log()
+    u = unit(paths, "TrackContact", log)
+    f = u.fmu
+    x, b = ctypes.c_double(), ctypes.c_int()
+    assert f.dll.fmi2GetRealStatus(f.component, 2, ctypes.byref(x)) == 3
+    assert log.last()[2].startswith("fmi2GetRealStatus is not allowed in state Instantiated")
+    f.setupExperiment(startTime=0.0)
+    f.enterInitializationMode()
+    assert f.dll.fmi2GetBooleanStatus(f.component, 3, ctypes.byref(b)) == 3
+    assert log.last()[2].startswith("fmi2GetBooleanStatus is not allowed in state Initialization")
+    with pytest.raises(FMICallException):
+        f.terminate()
+    assert log.last()[2] == ("fmi2Terminate is not allowed in state Initialization; "
+                             "allowed in: StepComplete, StepFailed")
+    f.exitInitializationMode()
+    f.doStep(0.0, 1e-5)
+    f.terminate()
+    with pytest.raises(FMICallException):
+        f.terminate()
+    assert log.last()[2].startswith("fmi2Terminate is not allowed in state Terminated")
+    assert f.dll.fmi2GetBooleanStatus(f.component, 3, ctypes.byref(b)) == 0 and b.value == 0
+    u.close(terminate=False)
+
+
+def test_booleans_other_than_0_and_1_are_refused(paths):
+    log = Log()
+    u = initialised(paths, "TrackContact", log)
+    f = u.fmu
+    assert f.dll.fmi2SetDebugLogging(f.component, 2, ctypes.c_size_t(0), None) == 3
+    assert log.last()[2] == ("fmi2SetDebugLogging: argument `loggingOn` = 2 is not an fmi2Boolean; "
+                             "allowed: fmi2True (1) or fmi2False (0)")
+    assert f.dll.fmi2DoStep(f.component, ctypes.c_double(0.0), ctypes.c_double(1e-5), -1) == 3
+    assert "argument `noSetFMUStatePriorToCurrentPoint` = -1" in log.last()[2]
+    u.fmu.doStep(0.0, 1e-5)
     u.close()
+
+
+def test_fmu_states_are_used_only_by_their_instance(paths):
+    log_a, log_b = Log(), Log()
+    a = initialised(paths, "TrackContact", log_a)
+    b = unit(paths, "TrackContact", log_b, instance="b")
+    a.fmu.doStep(0.0, 1e-3)
+    s = a.fmu.getFMUstate()
+    with pytest.raises(FMICallException):
+        b.fmu.setFMUstate(s)
+    assert log_b.last()[2].startswith("fmi2SetFMUstate: argument `FMUstate`")
+    assert "is not an FMU state of this instance" in log_b.last()[2]
+    copy = ctypes.c_void_p(s.value)
+    assert b.fmu.dll.fmi2FreeFMUstate(b.fmu.component, ctypes.byref(copy)) == 3
+    assert copy.value == s.value
+    a.fmu.setFMUstate(s)  # still a's
+    assert a.fmu.dll.fmi2FreeFMUstate(a.fmu.component, ctypes.byref(copy)) == 0
+    assert copy.value is None
+    again = ctypes.c_void_p(s.value)  # a second free of the same state
+    assert a.fmu.dll.fmi2FreeFMUstate(a.fmu.component, ctypes.byref(again)) == 3
+    assert "is not an FMU state of this instance" in log_a.last()[2]
+    assert a.fmu.dll.fmi2SetFMUstate(a.fmu.component, s) == 3
+    a.fmu.doStep(1e-3, 1e-3)
+    kept = a.fmu.getFMUstate()  # left for fmi2FreeInstance
+    assert kept.value
+    a.close()
+    b.close(terminate=False)
 
 
 def test_unsupported_functions_return_error_with_reason(paths):
@@ -373,6 +444,50 @@ def test_wrong_guid_is_refused(paths):
     with pytest.raises(Exception):
         fmu.instantiate(callbacks=log.callbacks)
     assert "matches none of" in log.text()
+
+
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem"])
+def test_each_fmu_binary_instantiates_only_its_own_guid(paths, name):
+    """The three FMUs carry the same library; inside an FMU it is named after the model
+    identifier, and takes only that FMU's GUID."""
+    import shutil
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    guids = {n: read_model_description(p).guid for n, p in paths.items()}
+    d = extract(paths[name])
+    try:
+        for other, guid in guids.items():
+            log = Log()
+            fmu = FMU2Slave(guid=guid, unzipDirectory=d, modelIdentifier=name, instanceName="x")
+            if other == name:
+                fmu.instantiate(callbacks=log.callbacks)
+                fmu.freeInstance()
+                continue
+            with pytest.raises(Exception):
+                fmu.instantiate(callbacks=log.callbacks)
+            assert log.records[-1][0] == 3
+            assert log.text() == (f'fmi2Instantiate: GUID "{guid}" belongs to {other}, but this binary '
+                                  f'is {name} (GUID {guids[name]}): instantiate {other} from its own FMU')
+            fmu.freeLibrary()
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+
+
+def test_development_library_instantiates_every_guid(paths):
+    from fmpy import read_model_description
+    lib = ctypes.CDLL(os.path.join(wf.TARGET_DIR, "release", "libwheelflat.so"))
+    lib.fmi2Instantiate.restype = ctypes.c_void_p
+    lib.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p,
+                                    ctypes.POINTER(fmi2CallbackFunctions), ctypes.c_int, ctypes.c_int]
+    lib.fmi2FreeInstance.argtypes = [ctypes.c_void_p]
+    log = Log()
+    for p in paths.values():
+        guid = read_model_description(p).guid.encode()
+        c = lib.fmi2Instantiate(b"dev", 1, guid, b"", ctypes.byref(log.callbacks), 0, 0)
+        assert c, log.text()
+        lib.fmi2FreeInstance(c)
+    assert not lib.fmi2Instantiate(b"dev", 1, b"{0}", b"", ctypes.byref(log.callbacks), 0, 0)
+    assert "matches none of TrackContact" in log.text()
 
 
 # ------------------------------------------------------------------ reset, states, instances

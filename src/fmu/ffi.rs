@@ -1,15 +1,21 @@
 //! The C boundary: every FMI 2.0 co-simulation function, exported unmangled. Each one
-//! checks its pointers, converts arguments and forwards to [`super::Instance`] inside
-//! `catch_unwind`, so no panic crosses into the master. cbindgen writes the C header of
-//! this file (`build.rs`); a test compiles it against the official `fmi2Functions.h`.
+//! claims the instance (a busy flag refuses a second thread), checks the state table
+//! ([`super::CALLS`]), its pointers and arguments, and forwards to [`super::Instance`]
+//! inside `catch_unwind`, so no panic crosses into the master. FMU states are owned by
+//! the instance that handed them out. cbindgen writes the C header of this file
+//! (`build.rs`); a test compiles it against the official `fmi2Functions.h`.
 
 #![allow(non_camel_case_types, non_snake_case, clippy::missing_safety_doc)]
 
-use super::{Instance, Kind, Logger, Snapshot, Status};
+use super::{CALLS, Call, Instance, Kind, Logger, Snapshot, Status};
+use std::cell::UnsafeCell;
+use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
 
-/// `fmi2Component`: pointer to an instance.
+/// `fmi2Component`: pointer to an instance (behind its busy flag).
 pub type fmi2Component = *mut c_void;
 /// `fmi2ComponentEnvironment`: the master's pointer handed back to the logger.
 pub type fmi2ComponentEnvironment = *mut c_void;
@@ -66,7 +72,8 @@ pub struct fmi2CallbackFunctions {
 const OK: fmi2Status = Status::Ok as c_int;
 const ERROR: fmi2Status = Status::Error as c_int;
 
-/// The master's logger with what it needs; used by one instance at a time.
+/// The master's logger with what it needs.
+#[derive(Clone)]
 struct CLogger {
     logger: unsafe extern "C" fn(
         fmi2ComponentEnvironment,
@@ -80,8 +87,8 @@ struct CLogger {
     name: CString,
 }
 
-// The master owns the environment pointer and calls an instance from one thread at a
-// time (FMI 2.0, section 2.1.4); the logger is only called during such calls.
+// The master owns the environment pointer; the logger is only called during calls of
+// the instance (FMI 2.0, section 2.1.4), from the thread that makes the call.
 unsafe impl Send for CLogger {}
 
 impl CLogger {
@@ -100,6 +107,154 @@ impl CLogger {
             )
         }
     }
+
+    /// Logs a message of the instance during the call recorded in `busy`, with the
+    /// function's name in front when the message does not name it: every message says
+    /// which call it answers.
+    fn log_in_call(&self, busy: &AtomicUsize, status: Status, category: &str, message: &str) {
+        match running(busy.load(Ordering::Relaxed)) {
+            Some(call) if !message.contains(call.name()) => {
+                self.log(status, category, &format!("{}: {message}", call.name()))
+            }
+            _ => self.log(status, category, message),
+        }
+    }
+}
+
+/// The function recorded in a busy flag: 0 is idle, else 1 + its index in [`CALLS`].
+fn running(flag: usize) -> Option<Call> {
+    CALLS.get(flag.wrapping_sub(1)).map(|c| c.0)
+}
+
+/// What an `fmi2Component` points to: the instance behind a busy flag.
+///
+/// FMI 2.0 forbids calling one instance from two threads at once; a master that does
+/// gets `fmi2Error` for the second call, which touches nothing but the flag and the
+/// copy of the logger here. (`fmi2FreeInstance` racing with another call is refused
+/// the same way; a call made after `fmi2FreeInstance` returned cannot be detected.)
+struct Component {
+    /// 0 when idle, else 1 + the index in [`CALLS`] of the function running. Shared with
+    /// the instance's logger, which names that function.
+    busy: Arc<AtomicUsize>,
+    /// The master's logger, for refusals that must not touch the instance.
+    logger: Option<CLogger>,
+    inner: UnsafeCell<Inner>,
+}
+
+/// The instance and the FMU states it handed out.
+struct Inner {
+    inst: Instance,
+    /// Every FMU state handed out and not freed, by address. A state pointer is used
+    /// only when it is a key here; the rest are freed with the instance.
+    states: HashMap<usize, Box<Snapshot>>,
+}
+
+impl Inner {
+    /// The state behind `p` when this instance handed it out and has not freed it;
+    /// `p` itself is never dereferenced.
+    fn state(&mut self, call: Call, what: &str, p: fmi2FMUstate) -> super::FmiResult<usize> {
+        let key = p as usize;
+        if self.states.contains_key(&key) {
+            return Ok(key);
+        }
+        let live = self.states.len();
+        self.inst.refuse(
+            Status::Error,
+            format!(
+                "{}: argument `{what}` = {p:p} is not an FMU state of this instance \
+                 (\"{}\", {live} live states): it belongs to another instance, was already \
+                 freed, or is not an FMU state; it was not used",
+                call.name(),
+                self.inst.name()
+            ),
+        )
+    }
+}
+
+/// Claims the instance behind `c` for `call`, or refuses (busy: logged).
+fn enter<'a>(c: fmi2Component, call: Call) -> Option<&'a Component> {
+    if c.is_null() {
+        return None;
+    }
+    let comp = unsafe { &*(c as *const Component) };
+    match comp
+        .busy
+        .compare_exchange(0, call as usize + 1, Ordering::Acquire, Ordering::Acquire)
+    {
+        Ok(_) => Some(comp),
+        Err(other) => {
+            let other = running(other).map_or("another function", |o| o.name());
+            let freeing = if call == Call::FreeInstance {
+                "; the instance was not freed"
+            } else {
+                "; the call was refused and the instance left as it was"
+            };
+            if let Some(l) = &comp.logger {
+                l.log(
+                    Status::Error,
+                    "logStatusError",
+                    &format!(
+                        "{0}: instance busy: {0} called while {other} is running on another \
+                         thread{freeing} (FMI 2.0: one call at a time per instance)",
+                        call.name()
+                    ),
+                );
+            }
+            None
+        }
+    }
+}
+
+/// Runs `f` on the instance behind `c` after the state check of `call`, catching
+/// panics.
+fn with_inner(
+    c: fmi2Component,
+    call: Call,
+    f: impl FnOnce(&mut Inner) -> super::FmiResult,
+) -> fmi2Status {
+    let Some(comp) = enter(c, call) else {
+        return ERROR;
+    };
+    // The busy flag is ours: no other thread touches the instance until it is cleared.
+    let inner = unsafe { &mut *comp.inner.get() };
+    let r = catch_unwind(AssertUnwindSafe(|| {
+        inner.inst.check(call)?;
+        f(inner)
+    }));
+    let status = match r {
+        Ok(Ok(())) => OK,
+        Ok(Err(r)) => r.status as c_int,
+        Err(p) => {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            let _ = catch_unwind(AssertUnwindSafe(|| {
+                inner.inst.poison();
+                inner.inst.log(
+                    Status::Error,
+                    "logStatusError",
+                    &format!(
+                        "{}: internal error ({what}); the instance was stopped, call fmi2Reset",
+                        call.name()
+                    ),
+                );
+            }));
+            ERROR
+        }
+    };
+    comp.busy.store(0, Ordering::Release);
+    status
+}
+
+/// Runs `f` on the instance behind `c`; see [`with_inner`].
+fn with(
+    c: fmi2Component,
+    call: Call,
+    f: impl FnOnce(&mut Instance) -> super::FmiResult,
+) -> fmi2Status {
+    with_inner(c, call, |x| f(&mut x.inst))
 }
 
 fn c_str(s: fmi2String) -> Option<String> {
@@ -110,42 +265,26 @@ fn c_str(s: fmi2String) -> Option<String> {
     }
 }
 
-/// Runs `f` on the instance behind `c`, catching panics.
-fn with(
-    c: fmi2Component,
-    call: &str,
-    f: impl FnOnce(&mut Instance) -> super::FmiResult,
-) -> fmi2Status {
-    if c.is_null() {
-        return ERROR;
+/// An `fmi2Boolean` argument: fmi2True (1) or fmi2False (0), nothing else.
+fn boolean(inst: &mut Instance, call: Call, what: &str, v: fmi2Boolean) -> super::FmiResult<bool> {
+    match v {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => inst.refuse(Status::Error, bool_message(call, what, v)),
     }
-    let inst = unsafe { &mut *(c as *mut Instance) };
-    match catch_unwind(AssertUnwindSafe(|| f(inst))) {
-        Ok(Ok(())) => OK,
-        Ok(Err(r)) => r.status as c_int,
-        Err(p) => {
-            let what = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                inst.poison();
-                inst.log(
-                    Status::Error,
-                    "logStatusError",
-                    &format!("{call}: internal error ({what}); the instance was terminated, call fmi2Reset"),
-                );
-            }));
-            ERROR
-        }
-    }
+}
+
+fn bool_message(call: Call, what: &str, v: fmi2Boolean) -> String {
+    format!(
+        "{}: argument `{what}` = {v} is not an fmi2Boolean; allowed: fmi2True (1) or fmi2False (0)",
+        call.name()
+    )
 }
 
 /// A slice from a C array, refusing a null pointer (also with a count of 0).
 fn slice<'a, T>(
     inst: &mut Instance,
-    call: &str,
+    call: Call,
     what: &str,
     p: *const T,
     n: usize,
@@ -153,7 +292,10 @@ fn slice<'a, T>(
     if p.is_null() {
         return inst.refuse(
             Status::Error,
-            format!("{call}: argument `{what}` is a null pointer (count {n})"),
+            format!(
+                "{}: argument `{what}` is a null pointer (count {n})",
+                call.name()
+            ),
         );
     }
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
@@ -161,7 +303,7 @@ fn slice<'a, T>(
 
 fn slice_mut<'a, T>(
     inst: &mut Instance,
-    call: &str,
+    call: Call,
     what: &str,
     p: *mut T,
     n: usize,
@@ -169,10 +311,90 @@ fn slice_mut<'a, T>(
     if p.is_null() {
         return inst.refuse(
             Status::Error,
-            format!("{call}: argument `{what}` is a null pointer (count {n})"),
+            format!(
+                "{}: argument `{what}` is a null pointer (count {n})",
+                call.name()
+            ),
         );
     }
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// A null pointer argument refused.
+fn null(inst: &mut Instance, call: Call, what: &str) -> super::FmiResult {
+    inst.refuse(
+        Status::Error,
+        format!("{}: argument `{what}` is a null pointer", call.name()),
+    )
+}
+
+// ------------------------------------------------------------------ which binary
+
+/// The FMU a binary belongs to, from its file name: FMI 2.0 names the shared library
+/// `binaries/<platform>/<modelIdentifier>.<ext>`, so the stem is the model identifier.
+/// `None` for any other name (the development library `libwheelflat.so`, a test
+/// executable that links the crate).
+pub fn kind_of_binary(path: &str) -> Option<Kind> {
+    let stem = std::path::Path::new(path).file_stem()?.to_str()?;
+    [
+        Kind::TrackContact,
+        Kind::RollPlaneVehicle,
+        Kind::CoupledSystem,
+    ]
+    .into_iter()
+    .find(|k| k.table().model_identifier == stem)
+}
+
+/// Path of the loaded object that holds this code (the FMU's shared library, or the
+/// executable that links the crate), from the dynamic loader.
+pub fn loaded_binary() -> Option<&'static str> {
+    static PATH: OnceLock<Option<String>> = OnceLock::new();
+    PATH.get_or_init(|| {
+        #[cfg(unix)]
+        {
+            let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
+            let addr = fmi2Instantiate as *const c_void;
+            if unsafe { libc::dladdr(addr, &mut info) } != 0 && !info.dli_fname.is_null() {
+                return c_str(info.dli_fname);
+            }
+            None
+        }
+        #[cfg(not(unix))]
+        {
+            None
+        }
+    })
+    .as_deref()
+}
+
+/// The FMU a GUID instantiates in a binary of `binary` (see [`kind_of_binary`]): only
+/// its own GUID when the binary is one FMU's, any of the three otherwise.
+pub fn kind_for_guid(binary: Option<Kind>, guid: &str) -> Result<Kind, String> {
+    let found = Kind::from_guid(guid);
+    match (binary, found) {
+        (None, Some(k)) => Ok(k),
+        (Some(b), Some(k)) if b == k => Ok(k),
+        (Some(b), Some(k)) => Err(format!(
+            "GUID \"{guid}\" belongs to {}, but this binary is {} (GUID {}): instantiate {} \
+             from its own FMU",
+            k.table().model_identifier,
+            b.table().model_identifier,
+            b.table().guid,
+            k.table().model_identifier
+        )),
+        (Some(b), None) => Err(format!(
+            "GUID \"{guid}\" matches none of the wheelflat FMUs; this binary is {} (GUID {})",
+            b.table().model_identifier,
+            b.table().guid
+        )),
+        (None, None) => Err(format!(
+            "GUID \"{guid}\" matches none of TrackContact ({}), RollPlaneVehicle ({}), \
+             CoupledSystem ({})",
+            super::vars::TRACK_CONTACT.guid,
+            super::vars::ROLL_PLANE_VEHICLE.guid,
+            super::vars::COUPLED_SYSTEM.guid
+        )),
+    }
 }
 
 // ------------------------------------------------------------------ common functions
@@ -197,36 +419,33 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     nCategories: usize,
     categories: *const fmi2String,
 ) -> fmi2Status {
-    with(c, "fmi2SetDebugLogging", |i| {
+    let call = Call::SetDebugLogging;
+    with(c, call, |i| {
+        let on = boolean(i, call, "loggingOn", loggingOn)?;
         let cats = if nCategories == 0 {
             Vec::new()
         } else {
-            let s = slice(
-                i,
-                "fmi2SetDebugLogging",
-                "categories",
-                categories,
-                nCategories,
-            )?;
+            let s = slice(i, call, "categories", categories, nCategories)?;
             let mut v = Vec::new();
-            for &p in s {
+            for (k, &p) in s.iter().enumerate() {
                 match c_str(p) {
                     Some(x) => v.push(x),
                     None => {
                         return i.refuse(
                             Status::Error,
-                            "fmi2SetDebugLogging: a category is a null pointer".into(),
+                            format!("fmi2SetDebugLogging: categories[{k}] is a null pointer"),
                         );
                     }
                 }
             }
             v
         };
-        i.set_debug_logging(loggingOn != 0, &cats)
+        i.set_debug_logging(on, &cats)
     })
 }
 
-/// `fmi2Instantiate`: the GUID selects TrackContact, RollPlaneVehicle or CoupledSystem.
+/// `fmi2Instantiate`: the GUID selects TrackContact, RollPlaneVehicle or CoupledSystem;
+/// inside an FMU only that FMU's GUID ([`kind_for_guid`]).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Instantiate(
     instanceName: fmi2String,
@@ -234,7 +453,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
     fmuGUID: fmi2String,
     _fmuResourceLocation: fmi2String,
     functions: *const fmi2CallbackFunctions,
-    _visible: fmi2Boolean,
+    visible: fmi2Boolean,
     loggingOn: fmi2Boolean,
 ) -> fmi2Component {
     let r = catch_unwind(AssertUnwindSafe(|| {
@@ -262,60 +481,85 @@ pub unsafe extern "C" fn fmi2Instantiate(
         if name.is_empty() {
             return fail("fmi2Instantiate: instanceName is null or empty".into());
         }
+        for (what, v) in [("visible", visible), ("loggingOn", loggingOn)] {
+            if v != 0 && v != 1 {
+                return fail(bool_message(Call::Instantiate, what, v));
+            }
+        }
         if fmuType != 1 {
             return fail(format!(
                 "fmi2Instantiate: fmuType = {fmuType}; these FMUs are Co-Simulation only (fmi2CoSimulation = 1)"
             ));
         }
         let guid = c_str(fmuGUID).unwrap_or_default();
-        let Some(kind) = Kind::from_guid(&guid) else {
-            return fail(format!(
-                "fmi2Instantiate: GUID \"{guid}\" matches none of TrackContact ({}), RollPlaneVehicle ({}), CoupledSystem ({})",
-                super::vars::TRACK_CONTACT.guid,
-                super::vars::ROLL_PLANE_VEHICLE.guid,
-                super::vars::COUPLED_SYSTEM.guid
-            ));
+        let binary = loaded_binary().and_then(kind_of_binary);
+        let kind = match kind_for_guid(binary, &guid) {
+            Ok(k) => k,
+            Err(m) => return fail(format!("fmi2Instantiate: {m}")),
         };
-        let logger: Logger = match clog {
-            Some(l) => Box::new(move |s, cat, m| l.log(s, cat, m)),
+        let busy = Arc::new(AtomicUsize::new(0));
+        let logger: Logger = match clog.clone() {
+            Some(l) => {
+                let busy = busy.clone();
+                Box::new(move |s, cat, m| l.log_in_call(&busy, s, cat, m))
+            }
             None => Box::new(|_, _, _| {}),
         };
-        let inst = Box::new(Instance::new(kind, &name, logger, loggingOn != 0));
-        Box::into_raw(inst) as fmi2Component
+        let comp = Box::new(Component {
+            busy,
+            logger: clog,
+            inner: UnsafeCell::new(Inner {
+                inst: Instance::new(kind, &name, logger, loggingOn == 1),
+                states: HashMap::new(),
+            }),
+        });
+        Box::into_raw(comp) as fmi2Component
     }));
     r.unwrap_or(std::ptr::null_mut())
 }
 
-/// `fmi2FreeInstance`.
+/// `fmi2FreeInstance`: the instance and every FMU state it handed out. Refused (and
+/// logged) while another thread is in a call of the instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    if !c.is_null() {
-        let _ = catch_unwind(AssertUnwindSafe(|| {
-            drop(unsafe { Box::from_raw(c as *mut Instance) })
-        }));
+    if enter(c, Call::FreeInstance).is_none() {
+        return;
     }
+    // The busy flag stays set: no call can start on the instance being freed.
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        let mut comp = unsafe { Box::from_raw(c as *mut Component) };
+        let inner = comp.inner.get_mut();
+        let n = inner.states.len();
+        inner
+            .inst
+            .log_call(|| format!("fmi2FreeInstance() ({n} FMU states freed with it)"));
+        drop(comp)
+    }));
 }
 
 /// `fmi2SetupExperiment`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetupExperiment(
     c: fmi2Component,
-    _toleranceDefined: fmi2Boolean,
+    toleranceDefined: fmi2Boolean,
     _tolerance: fmi2Real,
     startTime: fmi2Real,
     stopTimeDefined: fmi2Boolean,
     stopTime: fmi2Real,
 ) -> fmi2Status {
-    with(c, "fmi2SetupExperiment", |i| {
+    let call = Call::SetupExperiment;
+    with(c, call, |i| {
         i.log_call(|| format!("fmi2SetupExperiment(startTime={startTime}, stopTime={stopTime})"));
-        i.setup_experiment(startTime, (stopTimeDefined != 0).then_some(stopTime))
+        boolean(i, call, "toleranceDefined", toleranceDefined)?;
+        let stop_defined = boolean(i, call, "stopTimeDefined", stopTimeDefined)?;
+        i.setup_experiment(startTime, stop_defined.then_some(stopTime))
     })
 }
 
 /// `fmi2EnterInitializationMode`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-    with(c, "fmi2EnterInitializationMode", |i| {
+    with(c, Call::EnterInitializationMode, |i| {
         i.log_call(|| "fmi2EnterInitializationMode()".into());
         i.enter_initialization()
     })
@@ -324,7 +568,7 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2St
 /// `fmi2ExitInitializationMode`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    with(c, "fmi2ExitInitializationMode", |i| {
+    with(c, Call::ExitInitializationMode, |i| {
         i.log_call(|| "fmi2ExitInitializationMode()".into());
         i.exit_initialization()
     })
@@ -333,7 +577,7 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Sta
 /// `fmi2Terminate`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    with(c, "fmi2Terminate", |i| {
+    with(c, Call::Terminate, |i| {
         i.log_call(|| "fmi2Terminate()".into());
         i.terminate()
     })
@@ -342,7 +586,7 @@ pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
 /// `fmi2Reset`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    with(c, "fmi2Reset", |i| {
+    with(c, Call::Reset, |i| {
         i.log_call(|| "fmi2Reset()".into());
         i.reset()
     })
@@ -356,9 +600,10 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    with(c, "fmi2GetReal", |i| {
-        let vr = slice(i, "fmi2GetReal", "vr", vr, nvr)?;
-        let value = slice_mut(i, "fmi2GetReal", "value", value, nvr)?;
+    let call = Call::GetReal;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let value = slice_mut(i, call, "value", value, nvr)?;
         i.get_real(vr, value)?;
         i.log_call(|| format!("fmi2GetReal(vr={vr:?}) -> {value:?}"));
         Ok(())
@@ -373,9 +618,10 @@ pub unsafe extern "C" fn fmi2GetInteger(
     nvr: usize,
     value: *mut fmi2Integer,
 ) -> fmi2Status {
-    with(c, "fmi2GetInteger", |i| {
-        let vr = slice(i, "fmi2GetInteger", "vr", vr, nvr)?;
-        let value = slice_mut(i, "fmi2GetInteger", "value", value, nvr)?;
+    let call = Call::GetInteger;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let value = slice_mut(i, call, "value", value, nvr)?;
         i.get_integer(vr, value)?;
         i.log_call(|| format!("fmi2GetInteger(vr={vr:?}) -> {value:?}"));
         Ok(())
@@ -390,10 +636,11 @@ pub unsafe extern "C" fn fmi2GetBoolean(
     nvr: usize,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    with(c, "fmi2GetBoolean", |i| {
-        let vr = slice(i, "fmi2GetBoolean", "vr", vr, nvr)?;
-        slice_mut(i, "fmi2GetBoolean", "value", value, nvr)?;
-        i.no_such_type("fmi2GetBoolean", vr)
+    let call = Call::GetBoolean;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        slice_mut(i, call, "value", value, nvr)?;
+        i.no_such_type(call.name(), vr)
     })
 }
 
@@ -405,10 +652,11 @@ pub unsafe extern "C" fn fmi2GetString(
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
-    with(c, "fmi2GetString", |i| {
-        let vr = slice(i, "fmi2GetString", "vr", vr, nvr)?;
-        slice_mut(i, "fmi2GetString", "value", value, nvr)?;
-        i.no_such_type("fmi2GetString", vr)
+    let call = Call::GetString;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        slice_mut(i, call, "value", value, nvr)?;
+        i.no_such_type(call.name(), vr)
     })
 }
 
@@ -420,9 +668,10 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    with(c, "fmi2SetReal", |i| {
-        let vr = slice(i, "fmi2SetReal", "vr", vr, nvr)?;
-        let value = slice(i, "fmi2SetReal", "value", value, nvr)?;
+    let call = Call::SetReal;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let value = slice(i, call, "value", value, nvr)?;
         i.log_call(|| format!("fmi2SetReal(vr={vr:?}, value={value:?})"));
         i.set_real(vr, value)
     })
@@ -436,15 +685,17 @@ pub unsafe extern "C" fn fmi2SetInteger(
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
-    with(c, "fmi2SetInteger", |i| {
-        let vr = slice(i, "fmi2SetInteger", "vr", vr, nvr)?;
-        let value = slice(i, "fmi2SetInteger", "value", value, nvr)?;
+    let call = Call::SetInteger;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let value = slice(i, call, "value", value, nvr)?;
         i.log_call(|| format!("fmi2SetInteger(vr={vr:?}, value={value:?})"));
         i.set_integer(vr, value)
     })
 }
 
-/// `fmi2SetBoolean`: no Boolean variables.
+/// `fmi2SetBoolean`: no Boolean variables; values other than fmi2True/fmi2False are
+/// refused first.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetBoolean(
     c: fmi2Component,
@@ -452,10 +703,14 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
-    with(c, "fmi2SetBoolean", |i| {
-        let vr = slice(i, "fmi2SetBoolean", "vr", vr, nvr)?;
-        slice(i, "fmi2SetBoolean", "value", value, nvr)?;
-        i.no_such_type("fmi2SetBoolean", vr)
+    let call = Call::SetBoolean;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let value = slice(i, call, "value", value, nvr)?;
+        for (k, &v) in value.iter().enumerate() {
+            boolean(i, call, &format!("value[{k}]"), v)?;
+        }
+        i.no_such_type(call.name(), vr)
     })
 }
 
@@ -467,35 +722,53 @@ pub unsafe extern "C" fn fmi2SetString(
     nvr: usize,
     value: *const fmi2String,
 ) -> fmi2Status {
-    with(c, "fmi2SetString", |i| {
-        let vr = slice(i, "fmi2SetString", "vr", vr, nvr)?;
-        slice(i, "fmi2SetString", "value", value, nvr)?;
-        i.no_such_type("fmi2SetString", vr)
+    let call = Call::SetString;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        slice(i, call, "value", value, nvr)?;
+        i.no_such_type(call.name(), vr)
     })
 }
 
 // ------------------------------------------------------------------ FMU states
+//
+// Each instance owns the states it hands out ([`Inner::states`]): a state pointer is
+// looked up there before use and never dereferenced otherwise, so a state of another
+// instance, a freed one or a foreign pointer is refused; fmi2FreeInstance frees the
+// states left.
 
-/// `fmi2GetFMUstate`: a new state, or the one `*FMUstate` points to overwritten.
+/// `fmi2GetFMUstate`: a new state, or the state of this instance that `*FMUstate`
+/// points to overwritten.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetFMUstate(
     c: fmi2Component,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    with(c, "fmi2GetFMUstate", |i| {
-        i.log_call(|| "fmi2GetFMUstate()".into());
+    let call = Call::GetFMUstate;
+    with_inner(c, call, |x| {
+        x.inst.log_call(|| "fmi2GetFMUstate()".into());
         if FMUstate.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2GetFMUstate: argument `FMUstate` is a null pointer".into(),
-            );
+            return null(&mut x.inst, call, "FMUstate");
         }
-        let s = i.get_state()?;
         let slot = unsafe { &mut *FMUstate };
-        if slot.is_null() {
-            *slot = Box::into_raw(Box::new(s)) as fmi2FMUstate;
+        let old = if slot.is_null() {
+            None
         } else {
-            unsafe { *(*slot as *mut Snapshot) = s };
+            Some(x.state(call, "*FMUstate", *slot)?)
+        };
+        let s = x.inst.get_state()?;
+        match old {
+            Some(key) => {
+                if let Some(b) = x.states.get_mut(&key) {
+                    **b = s;
+                }
+            }
+            None => {
+                let b = Box::new(s);
+                let p = &*b as *const Snapshot as fmi2FMUstate;
+                x.states.insert(p as usize, b);
+                *slot = p;
+            }
         }
         Ok(())
     })
@@ -504,36 +777,34 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
 /// `fmi2SetFMUstate`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
-    with(c, "fmi2SetFMUstate", |i| {
-        i.log_call(|| "fmi2SetFMUstate()".into());
+    let call = Call::SetFMUstate;
+    with_inner(c, call, |x| {
+        x.inst.log_call(|| "fmi2SetFMUstate()".into());
         if FMUstate.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2SetFMUstate: argument `FMUstate` is a null pointer".into(),
-            );
+            return null(&mut x.inst, call, "FMUstate");
         }
-        let s = unsafe { &*(FMUstate as *const Snapshot) };
-        i.set_state(s)
+        let key = x.state(call, "FMUstate", FMUstate)?;
+        let Inner { inst, states } = x;
+        inst.set_state(&states[&key])
     })
 }
 
-/// `fmi2FreeFMUstate`.
+/// `fmi2FreeFMUstate`: `*FMUstate` NULL is a no-op.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    with(c, "fmi2FreeFMUstate", |i| {
-        i.log_call(|| "fmi2FreeFMUstate()".into());
+    let call = Call::FreeFMUstate;
+    with_inner(c, call, |x| {
+        x.inst.log_call(|| "fmi2FreeFMUstate()".into());
         if FMUstate.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2FreeFMUstate: argument `FMUstate` is a null pointer".into(),
-            );
+            return null(&mut x.inst, call, "FMUstate");
         }
         let slot = unsafe { &mut *FMUstate };
         if !slot.is_null() {
-            drop(unsafe { Box::from_raw(*slot as *mut Snapshot) });
+            let key = x.state(call, "*FMUstate", *slot)?;
+            x.states.remove(&key);
             *slot = std::ptr::null_mut();
         }
         Ok(())
@@ -547,16 +818,17 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     FMUstate: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    with(c, "fmi2SerializedFMUstateSize", |i| {
-        if FMUstate.is_null() || size.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2SerializedFMUstateSize: argument `FMUstate` or `size` is a null pointer"
-                    .into(),
-            );
+    let call = Call::SerializedFMUstateSize;
+    with_inner(c, call, |x| {
+        if FMUstate.is_null() {
+            return null(&mut x.inst, call, "FMUstate");
         }
-        let s = unsafe { &*(FMUstate as *const Snapshot) };
-        let b = i.serialize(s)?;
+        if size.is_null() {
+            return null(&mut x.inst, call, "size");
+        }
+        let key = x.state(call, "FMUstate", FMUstate)?;
+        let Inner { inst, states } = x;
+        let b = inst.serialize(&states[&key])?;
         unsafe { *size = b.len() };
         Ok(())
     })
@@ -570,24 +842,17 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    with(c, "fmi2SerializeFMUstate", |i| {
+    let call = Call::SerializeFMUstate;
+    with_inner(c, call, |x| {
         if FMUstate.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2SerializeFMUstate: argument `FMUstate` is a null pointer".into(),
-            );
+            return null(&mut x.inst, call, "FMUstate");
         }
-        let out = slice_mut(
-            i,
-            "fmi2SerializeFMUstate",
-            "serializedState",
-            serializedState,
-            size,
-        )?;
-        let s = unsafe { &*(FMUstate as *const Snapshot) };
-        let b = i.serialize(s)?;
+        let key = x.state(call, "FMUstate", FMUstate)?;
+        let out = slice_mut(&mut x.inst, call, "serializedState", serializedState, size)?;
+        let Inner { inst, states } = x;
+        let b = inst.serialize(&states[&key])?;
         if b.len() != size {
-            return i.refuse(
+            return inst.refuse(
                 Status::Error,
                 format!(
                     "fmi2SerializeFMUstate: size = {size} bytes; allowed: {} (from fmi2SerializedFMUstateSize)",
@@ -602,7 +867,8 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     })
 }
 
-/// `fmi2DeSerializeFMUstate`.
+/// `fmi2DeSerializeFMUstate`: a new state, or the state of this instance that
+/// `*FMUstate` points to overwritten.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,
@@ -610,27 +876,33 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     size: usize,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    with(c, "fmi2DeSerializeFMUstate", |i| {
+    let call = Call::DeSerializeFMUstate;
+    with_inner(c, call, |x| {
         if FMUstate.is_null() {
-            return i.refuse(
-                Status::Error,
-                "fmi2DeSerializeFMUstate: argument `FMUstate` is a null pointer".into(),
-            );
+            return null(&mut x.inst, call, "FMUstate");
         }
-        let bytes = slice(
-            i,
-            "fmi2DeSerializeFMUstate",
-            "serializedState",
-            serializedState,
-            size,
-        )?;
-        let bytes: Vec<u8> = bytes.iter().map(|&b| b as u8).collect();
-        let s = i.deserialize(&bytes)?;
         let slot = unsafe { &mut *FMUstate };
-        if !slot.is_null() {
-            drop(unsafe { Box::from_raw(*slot as *mut Snapshot) });
+        let old = if slot.is_null() {
+            None
+        } else {
+            Some(x.state(call, "*FMUstate", *slot)?)
+        };
+        let bytes = slice(&mut x.inst, call, "serializedState", serializedState, size)?;
+        let bytes: Vec<u8> = bytes.iter().map(|&b| b as u8).collect();
+        let s = x.inst.deserialize(&bytes)?;
+        match old {
+            Some(key) => {
+                if let Some(b) = x.states.get_mut(&key) {
+                    **b = s;
+                }
+            }
+            None => {
+                let b = Box::new(s);
+                let p = &*b as *const Snapshot as fmi2FMUstate;
+                x.states.insert(p as usize, b);
+                *slot = p;
+            }
         }
-        *slot = Box::into_raw(Box::new(s)) as fmi2FMUstate;
         Ok(())
     })
 }
@@ -646,17 +918,13 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     _dvKnown: *const fmi2Real,
     _dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2GetDirectionalDerivative",
-        "providesDirectionalDerivative is false",
-    )
+    unsupported(c, Call::GetDirectionalDerivative)
 }
 
-fn unsupported(c: fmi2Component, call: &str, why: &str) -> fmi2Status {
-    with(c, call, |i| {
-        i.refuse(Status::Error, format!("{call} is not supported: {why}"))
-    })
+/// A function refused in every state: [`Instance::check`] gives the reason from the
+/// table.
+fn unsupported(c: fmi2Component, call: Call) -> fmi2Status {
+    with(c, call, |_| Ok(()))
 }
 
 // ------------------------------------------------------------------ co-simulation
@@ -670,11 +938,7 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     _order: *const fmi2Integer,
     _value: *const fmi2Real,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2SetRealInputDerivatives",
-        "canInterpolateInputs is false; inputs are held over a step",
-    )
+    unsupported(c, Call::SetRealInputDerivatives)
 }
 
 /// `fmi2GetRealOutputDerivatives`: not supported (`maxOutputDerivativeOrder="0"`).
@@ -686,11 +950,7 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     _order: *const fmi2Integer,
     _value: *mut fmi2Real,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2GetRealOutputDerivatives",
-        "maxOutputDerivativeOrder is 0",
-    )
+    unsupported(c, Call::GetRealOutputDerivatives)
 }
 
 /// `fmi2DoStep`.
@@ -699,12 +959,19 @@ pub unsafe extern "C" fn fmi2DoStep(
     c: fmi2Component,
     currentCommunicationPoint: fmi2Real,
     communicationStepSize: fmi2Real,
-    _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+    noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
 ) -> fmi2Status {
-    with(c, "fmi2DoStep", |i| {
+    let call = Call::DoStep;
+    with(c, call, |i| {
         i.log_call(|| {
             format!("fmi2DoStep(t={currentCommunicationPoint}, h={communicationStepSize})")
         });
+        boolean(
+            i,
+            call,
+            "noSetFMUStatePriorToCurrentPoint",
+            noSetFMUStatePriorToCurrentPoint,
+        )?;
         i.do_step(currentCommunicationPoint, communicationStepSize)
     })
 }
@@ -712,11 +979,7 @@ pub unsafe extern "C" fn fmi2DoStep(
 /// `fmi2CancelStep`: steps are synchronous, there is nothing to cancel.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2CancelStep",
-        "fmi2DoStep is synchronous and never returns fmi2Pending",
-    )
+    unsupported(c, Call::CancelStep)
 }
 
 /// `fmi2GetStatus`: steps are synchronous, no status to ask for.
@@ -726,11 +989,7 @@ pub unsafe extern "C" fn fmi2GetStatus(
     _s: fmi2StatusKind,
     _value: *mut fmi2Status,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2GetStatus",
-        "fmi2DoStep is synchronous and never returns fmi2Pending",
-    )
+    unsupported(c, Call::GetStatus)
 }
 
 /// `fmi2GetRealStatus`: `fmi2LastSuccessfulTime`.
@@ -740,8 +999,9 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    with(c, "fmi2GetRealStatus", |i| {
-        let v = slice_mut(i, "fmi2GetRealStatus", "value", value, 1)?;
+    let call = Call::GetRealStatus;
+    with(c, call, |i| {
+        let v = slice_mut(i, call, "value", value, 1)?;
         if s != 2 {
             return i.refuse(
                 Status::Error,
@@ -760,11 +1020,7 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
     _s: fmi2StatusKind,
     _value: *mut fmi2Integer,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2GetIntegerStatus",
-        "FMI 2.0 defines no integer status",
-    )
+    unsupported(c, Call::GetIntegerStatus)
 }
 
 /// `fmi2GetBooleanStatus`: `fmi2Terminated` (the wheel reached the end of the track).
@@ -774,8 +1030,9 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
     s: fmi2StatusKind,
     value: *mut fmi2Boolean,
 ) -> fmi2Status {
-    with(c, "fmi2GetBooleanStatus", |i| {
-        let v = slice_mut(i, "fmi2GetBooleanStatus", "value", value, 1)?;
+    let call = Call::GetBooleanStatus;
+    with(c, call, |i| {
+        let v = slice_mut(i, call, "value", value, 1)?;
         if s != 3 {
             return i.refuse(
                 Status::Error,
@@ -794,9 +1051,77 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
     _s: fmi2StatusKind,
     _value: *mut fmi2String,
 ) -> fmi2Status {
-    unsupported(
-        c,
-        "fmi2GetStringStatus",
-        "fmi2PendingStatus never applies: steps are synchronous",
-    )
+    unsupported(c, Call::GetStringStatus)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_file_stem_of_the_binary_is_the_model_identifier() {
+        for (path, kind) in [
+            (
+                "/tmp/x/binaries/linux64/TrackContact.so",
+                Some(Kind::TrackContact),
+            ),
+            ("RollPlaneVehicle.so", Some(Kind::RollPlaneVehicle)),
+            (
+                "C:/fmu/binaries/win64/CoupledSystem.dll",
+                Some(Kind::CoupledSystem),
+            ),
+            (
+                "binaries/darwin64/CoupledSystem.dylib",
+                Some(Kind::CoupledSystem),
+            ),
+            ("/work/target/release/libwheelflat.so", None),
+            ("/work/target/release/deps/fmi_fuzz-0123abcd", None),
+            ("binaries/linux64/trackcontact.so", None),
+            ("binaries/linux64/TrackContact2.so", None),
+            ("", None),
+        ] {
+            assert_eq!(kind_of_binary(path), kind, "{path}");
+        }
+    }
+
+    #[test]
+    fn a_binary_of_one_fmu_instantiates_only_its_guid() {
+        use super::super::vars::{COUPLED_SYSTEM, ROLL_PLANE_VEHICLE, TRACK_CONTACT};
+        let kinds = [
+            (Kind::TrackContact, TRACK_CONTACT.guid),
+            (Kind::RollPlaneVehicle, ROLL_PLANE_VEHICLE.guid),
+            (Kind::CoupledSystem, COUPLED_SYSTEM.guid),
+        ];
+        for (k, g) in kinds {
+            // The development library (or a test executable): every GUID.
+            assert_eq!(kind_for_guid(None, g), Ok(k));
+            for (b, _) in kinds {
+                let r = kind_for_guid(Some(b), g);
+                if b == k {
+                    assert_eq!(r, Ok(k));
+                } else {
+                    let m = r.unwrap_err();
+                    let want = format!(
+                        "belongs to {}, but this binary is {}",
+                        k.table().model_identifier,
+                        b.table().model_identifier
+                    );
+                    assert!(m.contains(&want), "{m}");
+                }
+            }
+        }
+        let m = kind_for_guid(Some(Kind::TrackContact), "{0}").unwrap_err();
+        assert!(
+            m.contains("matches none of") && m.contains("this binary is TrackContact"),
+            "{m}"
+        );
+        assert!(
+            kind_for_guid(None, "")
+                .unwrap_err()
+                .contains("matches none of")
+        );
+        // Tests link the crate into their own executable: not an FMU binary.
+        let exe = loaded_binary().expect("dladdr names the executable");
+        assert_eq!(kind_of_binary(exe), None, "{exe}");
+    }
 }

@@ -91,17 +91,195 @@ impl Kind {
     }
 }
 
-/// States of the FMI 2.0 co-simulation state machine.
+/// States of the FMI 2.0 co-simulation state machine (section 4.2.4 of the standard).
+/// `stepInProgress` and `stepCanceled` do not occur: `fmi2DoStep` is synchronous. The
+/// discriminants are stored in serialized FMU states.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
 pub enum Phase {
     /// After `fmi2Instantiate` or `fmi2Reset`.
-    Instantiated,
+    Instantiated = 0,
     /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
-    Initialization,
+    Initialization = 1,
     /// Stepping.
-    StepComplete,
-    /// After `fmi2Terminate`, or after the model ended the run (wheel at the track end).
-    Terminated,
+    StepComplete = 2,
+    /// After `fmi2Terminate`.
+    Terminated = 3,
+    /// After `fmi2DoStep` returned `fmi2Discard` because the model ended the run (the
+    /// wheel reached the end of the track, `fmi2Terminated` status true): outputs can
+    /// be read and `fmi2Terminate` called, but no further step is taken.
+    StepFailed = 4,
+    /// After an internal error: only `fmi2Reset`, `fmi2FreeInstance`, FMU states and
+    /// reads for debugging.
+    Error = 5,
+}
+
+impl Phase {
+    /// The phase of a serialized state.
+    fn from_u8(p: u8) -> Option<Phase> {
+        [
+            Phase::Instantiated,
+            Phase::Initialization,
+            Phase::StepComplete,
+            Phase::Terminated,
+            Phase::StepFailed,
+            Phase::Error,
+        ]
+        .into_iter()
+        .find(|x| *x as u8 == p)
+    }
+}
+
+/// The FMI 2.0 co-simulation functions, in the order of [`CALLS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[allow(missing_docs)]
+pub enum Call {
+    GetTypesPlatform,
+    GetVersion,
+    SetDebugLogging,
+    Instantiate,
+    FreeInstance,
+    SetupExperiment,
+    EnterInitializationMode,
+    ExitInitializationMode,
+    Terminate,
+    Reset,
+    GetReal,
+    GetInteger,
+    GetBoolean,
+    GetString,
+    SetReal,
+    SetInteger,
+    SetBoolean,
+    SetString,
+    GetFMUstate,
+    SetFMUstate,
+    FreeFMUstate,
+    SerializedFMUstateSize,
+    SerializeFMUstate,
+    DeSerializeFMUstate,
+    GetDirectionalDerivative,
+    SetRealInputDerivatives,
+    GetRealOutputDerivatives,
+    DoStep,
+    CancelStep,
+    GetStatus,
+    GetRealStatus,
+    GetIntegerStatus,
+    GetBooleanStatus,
+    GetStringStatus,
+}
+
+/// Where a function may be called.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Allowed {
+    /// Not called on an instance (`fmi2GetTypesPlatform`, `fmi2GetVersion`,
+    /// `fmi2Instantiate`).
+    NoInstance,
+    /// In these phases.
+    In(&'static [Phase]),
+    /// Never: refused in every phase, for this reason.
+    Unsupported(&'static str),
+}
+
+use Phase::{
+    Error as Err_, Initialization as Ini, Instantiated as Ins, StepComplete as Stc,
+    StepFailed as Stf, Terminated as Ter,
+};
+
+/// Every phase.
+const ALL: &[Phase] = &[Ins, Ini, Stc, Stf, Ter, Err_];
+/// Where values can be read (`fmi2GetXXX`; after a failed step and in Error for
+/// debugging only).
+const READ: &[Phase] = &[Ini, Stc, Stf, Ter, Err_];
+/// Where values can be written (`fmi2SetXXX`).
+const WRITE: &[Phase] = &[Ins, Ini, Stc];
+/// Where the status functions answer.
+const STATUS: &[Phase] = &[Stc, Stf, Ter];
+
+/// The one table of the state machine: each function, its C name, and the phases it
+/// is allowed in, after the FMI 2.0 co-simulation state table (as the Reference-FMUs
+/// masks, without the phases these FMUs never enter). The C layer checks it before
+/// every call ([`Instance::check`]).
+#[rustfmt::skip]
+pub const CALLS: [(Call, &str, Allowed); 34] = [
+    (Call::GetTypesPlatform, "fmi2GetTypesPlatform", Allowed::NoInstance),
+    (Call::GetVersion, "fmi2GetVersion", Allowed::NoInstance),
+    (Call::SetDebugLogging, "fmi2SetDebugLogging", Allowed::In(ALL)),
+    (Call::Instantiate, "fmi2Instantiate", Allowed::NoInstance),
+    (Call::FreeInstance, "fmi2FreeInstance", Allowed::In(ALL)),
+    (Call::SetupExperiment, "fmi2SetupExperiment", Allowed::In(&[Ins])),
+    (Call::EnterInitializationMode, "fmi2EnterInitializationMode", Allowed::In(&[Ins])),
+    (Call::ExitInitializationMode, "fmi2ExitInitializationMode", Allowed::In(&[Ini])),
+    (Call::Terminate, "fmi2Terminate", Allowed::In(&[Stc, Stf])),
+    (Call::Reset, "fmi2Reset", Allowed::In(ALL)),
+    (Call::GetReal, "fmi2GetReal", Allowed::In(READ)),
+    (Call::GetInteger, "fmi2GetInteger", Allowed::In(READ)),
+    (Call::GetBoolean, "fmi2GetBoolean", Allowed::In(READ)),
+    (Call::GetString, "fmi2GetString", Allowed::In(READ)),
+    (Call::SetReal, "fmi2SetReal", Allowed::In(WRITE)),
+    (Call::SetInteger, "fmi2SetInteger", Allowed::In(WRITE)),
+    (Call::SetBoolean, "fmi2SetBoolean", Allowed::In(WRITE)),
+    (Call::SetString, "fmi2SetString", Allowed::In(WRITE)),
+    (Call::GetFMUstate, "fmi2GetFMUstate", Allowed::In(ALL)),
+    (Call::SetFMUstate, "fmi2SetFMUstate", Allowed::In(ALL)),
+    (Call::FreeFMUstate, "fmi2FreeFMUstate", Allowed::In(ALL)),
+    (Call::SerializedFMUstateSize, "fmi2SerializedFMUstateSize", Allowed::In(ALL)),
+    (Call::SerializeFMUstate, "fmi2SerializeFMUstate", Allowed::In(ALL)),
+    (Call::DeSerializeFMUstate, "fmi2DeSerializeFMUstate", Allowed::In(ALL)),
+    (
+        Call::GetDirectionalDerivative,
+        "fmi2GetDirectionalDerivative",
+        Allowed::Unsupported("providesDirectionalDerivative is false"),
+    ),
+    (
+        Call::SetRealInputDerivatives,
+        "fmi2SetRealInputDerivatives",
+        Allowed::Unsupported("canInterpolateInputs is false; inputs are held over a step"),
+    ),
+    (
+        Call::GetRealOutputDerivatives,
+        "fmi2GetRealOutputDerivatives",
+        Allowed::Unsupported("maxOutputDerivativeOrder is 0"),
+    ),
+    (Call::DoStep, "fmi2DoStep", Allowed::In(&[Stc])),
+    (
+        Call::CancelStep,
+        "fmi2CancelStep",
+        Allowed::Unsupported("fmi2DoStep is synchronous and never returns fmi2Pending"),
+    ),
+    (
+        Call::GetStatus,
+        "fmi2GetStatus",
+        Allowed::Unsupported("fmi2DoStep is synchronous and never returns fmi2Pending"),
+    ),
+    (Call::GetRealStatus, "fmi2GetRealStatus", Allowed::In(STATUS)),
+    (
+        Call::GetIntegerStatus,
+        "fmi2GetIntegerStatus",
+        Allowed::Unsupported("FMI 2.0 defines no integer status"),
+    ),
+    (Call::GetBooleanStatus, "fmi2GetBooleanStatus", Allowed::In(STATUS)),
+    (
+        Call::GetStringStatus,
+        "fmi2GetStringStatus",
+        Allowed::Unsupported("fmi2PendingStatus never applies: steps are synchronous"),
+    ),
+];
+
+impl Call {
+    /// The C name (`fmi2DoStep`).
+    pub fn name(self) -> &'static str {
+        CALLS[self as usize].1
+    }
+    /// Where it may be called.
+    pub fn allowed(self) -> Allowed {
+        CALLS[self as usize].2
+    }
+    /// The function with this C name.
+    pub fn from_name(name: &str) -> Option<Call> {
+        CALLS.iter().find(|c| c.1 == name).map(|c| c.0)
+    }
 }
 
 /// The running model behind an instance.
@@ -134,6 +312,8 @@ pub struct Snapshot {
     time: f64,
     start_time: f64,
     ended: bool,
+    /// Why the run had stopped (phase `Error` after a value beyond the health bounds).
+    failed: Option<String>,
 }
 
 /// A logger: status, category, message.
@@ -272,9 +452,14 @@ impl Instance {
     pub fn name(&self) -> &str {
         &self.name
     }
-    /// State-machine phase.
+    /// State-machine phase. A step that ended the run (`ended`) leaves the instance in
+    /// [`Phase::StepFailed`] even where the stepping code left the phase at
+    /// `StepComplete`.
     pub fn phase(&self) -> Phase {
-        self.phase
+        match self.phase {
+            Phase::StepComplete if self.ended => Phase::StepFailed,
+            p => p,
+        }
     }
     /// Communication time (s).
     pub fn time(&self) -> f64 {
@@ -344,25 +529,92 @@ impl Instance {
 
     // ---------------------------------------------------------------- state machine
 
-    fn require(&mut self, call: &str, allowed: &[Phase]) -> FmiResult {
-        if allowed.contains(&self.phase) {
-            Ok(())
-        } else {
-            let names: Vec<String> = allowed.iter().map(|p| format!("{p:?}")).collect();
-            self.refuse(
-                Status::Error,
-                format!(
-                    "{call} is not allowed in state {:?}; allowed in: {}",
-                    self.phase,
-                    names.join(", ")
+    /// Refuses `call` unless the table [`CALLS`] allows it in the current phase (or
+    /// refuses it as unsupported). The message names the function, the phase, where
+    /// the function is allowed and, after a failed step or an internal error, why the
+    /// instance is there.
+    #[inline]
+    pub fn check(&mut self, call: Call) -> FmiResult {
+        match call.allowed() {
+            Allowed::NoInstance => Ok(()),
+            Allowed::In(phases) if phases.contains(&self.phase()) => Ok(()),
+            _ => self.refuse_call(call),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_call(&mut self, call: Call) -> FmiResult {
+        let phases = match call.allowed() {
+            Allowed::Unsupported(why) => {
+                return self.refuse(
+                    Status::Error,
+                    format!("{} is not supported: {why}", call.name()),
+                );
+            }
+            Allowed::In(p) => p,
+            Allowed::NoInstance => return Ok(()),
+        };
+        let phase = self.phase();
+        let names: Vec<String> = phases.iter().map(|p| format!("{p:?}")).collect();
+        let why = match phase {
+            Phase::StepFailed if self.ended => format!(
+                "; the model ended the run at t = {} s (the wheel reached the end of the \
+                 track; fmi2Terminated status is true): outputs can still be read and \
+                 fmi2Terminate called; use fmi2Reset to run again",
+                self.time
+            ),
+            Phase::StepFailed => {
+                "; a step failed: outputs can still be read and fmi2Terminate called; use \
+                 fmi2Reset to run again"
+                    .to_string()
+            }
+            Phase::Error => match &self.failed {
+                Some(f) => format!(
+                    "; the run stopped at t = {} s: {f}; call fmi2Reset or fmi2SetFMUstate",
+                    self.time
                 ),
-            )
+                None => "; an internal error stopped the instance: call fmi2Reset".into(),
+            },
+            Phase::Terminated => "; use fmi2Reset to run again".into(),
+            _ => String::new(),
+        };
+        self.refuse(
+            Status::Error,
+            format!(
+                "{} is not allowed in state {phase:?}; allowed in: {}{why}",
+                call.name(),
+                names.join(", ")
+            ),
+        )
+    }
+
+    /// The state check of `call` by its C name, for callers that still pass their own
+    /// list: `allowed` must be the table's entry (checked in debug builds); a refusal
+    /// comes from [`Instance::check`], with the table's message. New code calls
+    /// [`Instance::check`] with the [`Call`].
+    #[inline]
+    fn require(&mut self, call: &str, allowed: &[Phase]) -> FmiResult {
+        debug_assert!(
+            Call::from_name(call)
+                .is_some_and(|c| matches!(c.allowed(), Allowed::In(p) if p == allowed)),
+            "{call}: the phases {allowed:?} are not the table's"
+        );
+        if allowed.contains(&self.phase()) {
+            return Ok(());
+        }
+        match Call::from_name(call) {
+            Some(c) => self.refuse_call(c),
+            None => self.refuse(
+                Status::Error,
+                format!("{call}: not an FMI 2.0 co-simulation function"),
+            ),
         }
     }
 
     /// `fmi2SetupExperiment`.
     pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> FmiResult {
-        self.require("fmi2SetupExperiment", &[Phase::Instantiated])?;
+        self.check(Call::SetupExperiment)?;
         if !start.is_finite() {
             return self.refuse(
                 Status::Error,
@@ -386,14 +638,14 @@ impl Instance {
 
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization(&mut self) -> FmiResult {
-        self.require("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
+        self.check(Call::EnterInitializationMode)?;
         self.phase = Phase::Initialization;
         Ok(())
     }
 
     /// `fmi2ExitInitializationMode`: builds the model if parameters changed.
     pub fn exit_initialization(&mut self) -> FmiResult {
-        self.require("fmi2ExitInitializationMode", &[Phase::Initialization])?;
+        self.check(Call::ExitInitializationMode)?;
         self.ensure_model()?;
         self.phase = Phase::StepComplete;
         self.log_event(|| "initialised in static equilibrium".into());
@@ -432,14 +684,7 @@ impl Instance {
 
     /// `fmi2Terminate`.
     pub fn terminate(&mut self) -> FmiResult {
-        self.require(
-            "fmi2Terminate",
-            &[
-                Phase::StepComplete,
-                Phase::Terminated,
-                Phase::Initialization,
-            ],
-        )?;
+        self.check(Call::Terminate)?;
         self.phase = Phase::Terminated;
         Ok(())
     }
@@ -465,7 +710,7 @@ impl Instance {
     pub fn poison(&mut self) {
         self.model = None;
         self.dirty = true;
-        self.phase = Phase::Terminated;
+        self.phase = Phase::Error;
     }
 
     // ---------------------------------------------------------------- model
@@ -701,14 +946,7 @@ impl Instance {
 
     /// Reads variables into `out` (Real or Integer/Enumeration by `real`).
     fn get(&mut self, call: &str, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
-        self.require(
-            call,
-            &[
-                Phase::Initialization,
-                Phase::StepComplete,
-                Phase::Terminated,
-            ],
-        )?;
+        self.require(call, READ)?;
         let mut needs_model = false;
         for &r in vrs {
             let s = self.spec(call, r)?;
@@ -762,12 +1000,13 @@ impl Instance {
             }
             if !o.is_finite() {
                 let (name, x) = (s.name, *o);
+                let why = format!("`{name}` = {x} at t = {} s is not finite", self.time);
+                self.failed = Some(why.clone());
+                self.phase = Phase::Error;
                 return self.refuse(
                     Status::Error,
                     format!(
-                        "{call}: `{name}` = {x} at t = {} s is not finite: internal error, \
-                         please report it with the parameters",
-                        self.time
+                        "{call}: {why}; the run cannot go on: call fmi2Reset or fmi2SetFMUstate"
                     ),
                 );
             }
@@ -973,15 +1212,7 @@ impl Instance {
     /// physical run reaches gives `fmi2Error` naming it, and the run can then only be
     /// reset or restored from an FMU state.
     pub fn do_step(&mut self, t: f64, h: f64) -> FmiResult {
-        self.require("fmi2DoStep", &[Phase::StepComplete])?;
-        if let Some(why) = &self.failed {
-            let m = format!(
-                "fmi2DoStep: the run stopped at t = {} s ({why}); call fmi2Reset or \
-                 fmi2SetFMUstate",
-                self.time
-            );
-            return self.refuse(Status::Error, m);
-        }
+        self.check(Call::DoStep)?;
         if !(h.is_finite() && h > 0.0) {
             return self.refuse(
                 Status::Error,
@@ -1067,8 +1298,10 @@ impl Instance {
         if let Err(e) = r {
             if matches!(e, Error::OffTrack { .. }) {
                 self.ended = true;
+                self.phase = Phase::StepFailed;
             } else {
                 self.failed = Some(e.to_string());
+                self.phase = Phase::Error;
             }
             return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
@@ -1101,6 +1334,7 @@ impl Instance {
             time: self.time,
             start_time: self.start_time,
             ended: self.ended,
+            failed: self.failed.clone(),
         })
     }
 
@@ -1123,7 +1357,7 @@ impl Instance {
         self.time = s.time;
         self.start_time = s.start_time;
         self.ended = s.ended;
-        self.failed = None;
+        self.failed.clone_from(&s.failed);
         let t = self.time;
         self.log_event(|| format!("state restored at t = {t} s"));
         Ok(())
@@ -1149,6 +1383,9 @@ impl Instance {
         b.push(s.model.is_some() as u8);
         b.extend_from_slice(&s.time.to_le_bytes());
         b.extend_from_slice(&s.start_time.to_le_bytes());
+        let failed = s.failed.as_deref().unwrap_or("").as_bytes();
+        b.extend_from_slice(&(failed.len() as u64).to_le_bytes());
+        b.extend_from_slice(failed);
         for x in [
             s.published.static_load[0],
             s.published.static_load[1],
@@ -1180,6 +1417,41 @@ impl Instance {
         }
     }
 
+    /// The numbers of a serialized state are what an instance can hold: a finite clock
+    /// from 0 on, finite calculated values and model state, parameters and inputs
+    /// inside their ranges (as fmi2SetReal would take them).
+    fn check_stored(
+        &self,
+        (time, start_time): (f64, f64),
+        pubs: &[f64],
+        values: &[f64],
+        state: &[f64],
+    ) -> std::result::Result<(), String> {
+        if !(time.is_finite() && start_time.is_finite() && time >= start_time) {
+            return Err(format!(
+                "stored time {time} s and start time {start_time} s are not finite with the \
+                 time at or after the start"
+            ));
+        }
+        if let Some(x) = pubs.iter().find(|x| !x.is_finite()) {
+            return Err(format!("a stored calculated parameter is {x}"));
+        }
+        for v in self.kind.table().vars {
+            let x = values[v.vr as usize];
+            let known = matches!(v.causality, Causality::Parameter | Causality::Input);
+            if known && !(x.is_finite() && x >= v.min && x <= v.max) {
+                return Err(format!(
+                    "stored `{}` = {x} is out of range (finite, {} to {})",
+                    v.name, v.min, v.max
+                ));
+            }
+        }
+        if let Some(k) = state.iter().position(|x| !x.is_finite()) {
+            return Err(format!("model state [{k}] = {} is not finite", state[k]));
+        }
+        Ok(())
+    }
+
     fn decode(&mut self, bytes: &[u8]) -> std::result::Result<Snapshot, String> {
         let mut r = Cursor { b: bytes, at: 0 };
         if r.take(MAGIC.len())? != MAGIC {
@@ -1195,17 +1467,19 @@ impl Instance {
                 self.kind.table().guid
             ));
         }
-        let phase = match r.take(1)?[0] {
-            0 => Phase::Instantiated,
-            1 => Phase::Initialization,
-            2 => Phase::StepComplete,
-            3 => Phase::Terminated,
-            p => return Err(format!("bad phase {p}")),
-        };
+        let p = r.take(1)?[0];
+        let phase = Phase::from_u8(p).ok_or_else(|| format!("bad phase {p}"))?;
         let ended = r.take(1)?[0] != 0;
         let has_model = r.take(1)?[0] != 0;
         let time = r.f64()?;
         let start_time = r.f64()?;
+        let n = r.u64()? as usize;
+        let failed = std::str::from_utf8(r.take(n)?)
+            .map_err(|_| "the stored reason for a stopped run is not UTF-8".to_string())?;
+        let failed = (!failed.is_empty()).then(|| failed.to_string());
+        if (phase == Phase::Error) != failed.is_some() {
+            return Err("a stopped run's state without its reason, or the reverse".into());
+        }
         let mut pubs = [0.0; 7];
         for x in &mut pubs {
             *x = r.f64()?;
@@ -1229,6 +1503,7 @@ impl Instance {
         if r.at != bytes.len() {
             return Err(format!("{} trailing bytes", bytes.len() - r.at));
         }
+        self.check_stored((time, start_time), &pubs, &values, &state)?;
         let model = if has_model {
             // Build with the stored parameters on a scratch instance, then overwrite
             // the dynamic state.
@@ -1260,6 +1535,7 @@ impl Instance {
             time,
             start_time,
             ended,
+            failed,
         })
     }
 }
@@ -1377,6 +1653,147 @@ mod tests {
         i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
         assert!((p[0] - 107.66e3).abs() < 2e3);
         assert_eq!(log.lock().unwrap().len(), 3, "each refusal logged once");
+    }
+
+    #[test]
+    fn the_state_table_lists_every_function_once_in_enum_order() {
+        for (k, (call, name, _)) in CALLS.iter().enumerate() {
+            assert_eq!(*call as usize, k, "{name}");
+            assert_eq!(call.name(), *name);
+            assert_eq!(Call::from_name(name), Some(*call));
+        }
+        for p in ALL {
+            assert_eq!(Phase::from_u8(*p as u8), Some(*p));
+        }
+        assert_eq!(Phase::from_u8(6), None);
+    }
+
+    #[test]
+    fn terminate_and_status_follow_the_state_table() {
+        let (mut i, log) = instance(Kind::TrackContact);
+        let last = |log: &Arc<Mutex<Vec<String>>>| log.lock().unwrap().last().cloned().unwrap();
+        for call in [Call::GetRealStatus, Call::GetBooleanStatus, Call::Terminate] {
+            assert_eq!(i.check(call).unwrap_err().status, Status::Error);
+            let m = last(&log);
+            assert!(
+                m.starts_with(&format!(
+                    "{} is not allowed in state Instantiated",
+                    call.name()
+                )),
+                "{m}"
+            );
+        }
+        i.enter_initialization().unwrap();
+        for call in [Call::GetRealStatus, Call::GetBooleanStatus] {
+            assert!(i.check(call).is_err());
+            assert!(last(&log).contains("in state Initialization"));
+        }
+        let e = i.terminate().unwrap_err();
+        assert_eq!(
+            e.message,
+            "fmi2Terminate is not allowed in state Initialization; allowed in: StepComplete, StepFailed"
+        );
+        i.exit_initialization().unwrap();
+        i.check(Call::GetRealStatus).unwrap();
+        i.terminate().unwrap();
+        assert_eq!(i.phase(), Phase::Terminated);
+        let e = i.terminate().unwrap_err();
+        assert!(
+            e.message
+                .starts_with("fmi2Terminate is not allowed in state Terminated"),
+            "{}",
+            e.message
+        );
+        assert!(e.message.contains("fmi2Reset"), "{}", e.message);
+        i.check(Call::GetBooleanStatus).unwrap();
+        i.reset().unwrap();
+        assert_eq!(i.phase(), Phase::Instantiated);
+        assert!(i.check(Call::GetRealStatus).is_err());
+    }
+
+    #[test]
+    fn after_the_model_ended_the_run_steps_are_refused_and_outputs_readable() {
+        let (mut i, log) = instance(Kind::CoupledSystem);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 0.01).unwrap();
+        let e = i.do_step(0.01, 5.0).unwrap_err();
+        assert_eq!(e.status, Status::Discard);
+        assert_eq!(i.phase(), Phase::StepFailed);
+        assert!(i.terminated_by_model());
+        assert_eq!(i.last_successful_time(), 0.01);
+        let n = log.lock().unwrap().len();
+        for h in [1e-4, 5.0] {
+            let e = i.do_step(0.01, h).unwrap_err();
+            assert_eq!(e.status, Status::Error);
+            assert!(
+                e.message
+                    .starts_with("fmi2DoStep is not allowed in state StepFailed; allowed in: StepComplete; the model ended the run at t = 0.01 s"),
+                "{}",
+                e.message
+            );
+            assert!(e.message.contains("use fmi2Reset"), "{}", e.message);
+        }
+        assert_eq!(log.lock().unwrap().len(), n + 2, "each refusal logged");
+        // Inputs can no longer be set; outputs and status can be read.
+        assert!(i.set_real(&[vr::SPEED], &[10.0]).is_err());
+        let mut p = [0.0];
+        i.get_real(&[vr::POSITION], &mut p).unwrap();
+        // The track stands at its grid point nearest 0.01 s.
+        let dt = i.published.step;
+        assert!((p[0] - (1.37 + (0.01 / dt).round() * dt * 70.0 / 3.6)).abs() < 1e-9);
+        i.check(Call::GetRealStatus).unwrap();
+        i.check(Call::GetBooleanStatus).unwrap();
+        // A state taken here restores the failed step.
+        let s = i.get_state().unwrap();
+        let b = i.serialize(&s).unwrap();
+        i.terminate().unwrap();
+        assert_eq!(i.phase(), Phase::Terminated);
+        assert!(i.terminated_by_model());
+        let d = i.deserialize(&b).unwrap();
+        i.set_state(&d).unwrap();
+        assert_eq!(i.phase(), Phase::StepFailed);
+        assert!(i.do_step(0.01, 1e-4).is_err());
+        i.reset().unwrap();
+        assert!(!i.terminated_by_model());
+        assert_eq!(i.phase(), Phase::Instantiated);
+    }
+
+    #[test]
+    fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
+        let (mut i, _) = instance(Kind::RollPlaneVehicle);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 1e-3).unwrap();
+        let s = i.get_state().unwrap();
+        let b = i.serialize(&s).unwrap();
+        assert!(i.deserialize(&b).is_ok());
+        let put = |at: usize, x: f64| {
+            let mut c = b.clone();
+            c[at..at + 8].copy_from_slice(&x.to_le_bytes());
+            c
+        };
+        let guid = i.kind.table().guid.len();
+        let time_at = MAGIC.len() + 8 + guid + 3;
+        // time, start time, the reason's length (0), seven calculated parameters, the
+        // value count
+        let values_at = time_at + 8 * 10 + 8;
+        for (at, x, why) in [
+            (b.len() - 8, f64::NAN, "model state"),
+            (b.len() - 8, f64::INFINITY, "model state"),
+            (time_at, -1.0, "stored time"),
+            (time_at + 8, f64::NAN, "start time NaN"),
+            (time_at + 24, f64::NAN, "calculated parameter"),
+            (values_at + 8 * vr::SPEED as usize, -5.0, "`speed` = -5"),
+            (
+                values_at + 8 * vr::GRAVITY as usize,
+                f64::NAN,
+                "`gravity` = NaN",
+            ),
+        ] {
+            let e = i.deserialize(&put(at, x)).unwrap_err();
+            assert!(e.message.contains(why), "{why}: {}", e.message);
+        }
     }
 
     #[test]
