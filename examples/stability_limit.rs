@@ -22,14 +22,7 @@ use wheelflat::contact::ContactLaw;
 use wheelflat::params::{Scenario, TrackSpec, VehicleSpec};
 use wheelflat::profile::{FlatSpec, WheelProfile};
 use wheelflat::solver::Simulation;
-use wheelflat::track::{PointLoad, Track, TrackParams};
-
-/// `dP/d delta` (N/m) of `law` at force `p` (N) for `wheel` at axle angle `gamma`.
-fn contact_stiffness(law: &ContactLaw, wheel: &WheelProfile, gamma: f64, p: f64) -> f64 {
-    let d = law.overlap_for_force(wheel, gamma, p);
-    let h = 1e-6 * d;
-    (law.evaluate(wheel, gamma, d + h).force - law.evaluate(wheel, gamma, d - h).force) / (2.0 * h)
-}
+use wheelflat::track::{Track, TrackParams, perturbation_growth};
 
 /// Exact undamped limit `2 / sqrt(lambda_max)` (s) of the assembled track with a spring
 /// `kc` (N/m) to ground under the wheel at `x` (m) on the left rail.
@@ -70,58 +63,9 @@ fn exact_limit(p: TrackParams, kc: f64, x: f64) -> f64 {
 
 /// True when the track stepped at `dt` (s) with a contact spring `kc` (N/m) under
 /// `x + v t` (m) on the left rail grows from a random perturbation by 1e6 within
-/// `steps`.
+/// `steps` ([`perturbation_growth`]).
 fn unstable(p: TrackParams, dt: f64, kc: f64, x: f64, v: f64, steps: usize) -> bool {
-    let mut t = Track::new_without_stability_check(p, dt).unwrap();
-    let nk = t.nodes();
-    let dx = p.dx();
-    // Deterministic pseudo-random start (xorshift), rail ends at zero.
-    let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
-    let mut rnd = || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let mut z = vec![0.0; 2 * nk];
-    let mut th = vec![0.0; 2 * nk];
-    for r in 0..2 {
-        for k in 1..nk - 1 {
-            z[r * nk + k] = 1e-6 * rnd();
-            th[r * nk + k] = 1e-6 / dx * rnd();
-        }
-    }
-    t.set_state(&z, &th, &z, &th);
-    let amp = |t: &Track| {
-        let mut a: f64 = 0.0;
-        for r in 0..2 {
-            for (zz, tt) in t.rail_z(r).iter().zip(t.rail_theta(r)) {
-                if !(zz.is_finite() && tt.is_finite()) {
-                    return f64::INFINITY;
-                }
-                a = a.max(zz.abs() / 1e-6).max((tt * dx).abs() / 1e-6);
-            }
-        }
-        a
-    };
-    let a0 = amp(&t);
-    for j in 0..steps {
-        let xw = x + v * j as f64 * dt;
-        let load = [PointLoad {
-            rail: 0,
-            position: xw,
-            force: kc * t.rail_z_at(0, xw),
-        }];
-        t.step(&load);
-        if j % 1000 == 999 {
-            let a = amp(&t);
-            if !a.is_finite() || a > 1e6 * a0 {
-                return true;
-            }
-        }
-    }
-    let a = amp(&t);
-    !a.is_finite() || a > 1e6 * a0
+    !(perturbation_growth(p, dt, kc, (x, v), steps, 1e6).unwrap() <= 1e6)
 }
 
 /// Smallest `dt / dt_c` (reported) at which the stepper is unstable, to 1e-6, the
@@ -178,7 +122,7 @@ fn main() {
     for &mlt in &multiples {
         let p = mlt * p0;
         let d = law.overlap_for_force(&perfect, 0.0, p);
-        let kp = contact_stiffness(&law, &perfect, 0.0, p);
+        let kp = law.stiffness(&perfect, 0.0, p);
         let alpha = 2.0 * (d / (2.0 * s.wheel_radius)).sqrt().asin();
         // Flat centre at beta0 - gamma relative to the contact point: scan it across
         // the patch and a little beyond (flat half-angle plus the widest patch).
@@ -187,7 +131,7 @@ fn main() {
         for i in 0..=samples {
             let rel = -(half + 0.06) + 2.0 * (half + 0.06) * i as f64 / samples as f64;
             let gamma = beta0 - rel;
-            let k = contact_stiffness(&law, &flat, gamma, p);
+            let k = law.stiffness(&flat, gamma, p);
             if k > best.0 {
                 best = (k, rel);
             }

@@ -231,6 +231,20 @@ impl ContactLaw {
         })
     }
 
+    /// Contact stiffness `dP / d delta` (N/m) at contact force `force` (N) for a wheel
+    /// with profile `wheel` at axle rotation `gamma` (rad), by a central difference
+    /// (relative step 1e-6) about the overlap that carries the force
+    /// ([`ContactLaw::overlap_for_force`]). For the adaptive law on a perfect wheel it is
+    /// `2 K_w alpha_w` (differentiating (2.5)); for Hertz `1.5 C_H delta^(1/2)`. The
+    /// linearised contact couples the rail under the wheel to the wheel in the explicit
+    /// scheme ([`crate::track::TrackParams::critical_time_step_with_contact`]).
+    pub fn stiffness(&self, wheel: &WheelProfile, gamma: f64, force: f64) -> f64 {
+        let d = self.overlap_for_force(wheel, gamma, force);
+        let e = 1e-6 * d;
+        let p = |x: f64| self.evaluate(wheel, gamma, x).force;
+        (p(d + e) - p(d - e)) / (2.0 * e)
+    }
+
     /// Contact state for a wheel with profile `wheel` at axle rotation `gamma` (rad)
     /// and overlap `overlap = z_rail - z_wheel` (m).
     #[inline(always)]
@@ -1057,5 +1071,23 @@ mod tests {
         let law = ContactLaw::adaptive(KW).unwrap();
         let d = law.overlap_for_force(&w, 0.0, 107.6e3);
         assert!((law.evaluate(&w, 0.0, d).force - 107.6e3).abs() < 1e-6);
+    }
+
+    #[test]
+    fn contact_stiffness_is_the_derivative_of_the_closed_forms() {
+        // Adaptive, perfect wheel: differentiating (2.5) gives 2 K_w alpha_w with
+        // cos alpha_w = (R_w - delta) / R_w; Hertz: 1.5 C_H delta^(1/2).
+        let w = WheelProfile::perfect(R).unwrap();
+        let law = ContactLaw::adaptive(KW).unwrap();
+        for p in [50e3, 107.7e3, 430e3, 2.15e6] {
+            let d = law.overlap_for_force(&w, 0.0, p);
+            let alpha = ((R - d) / R).acos();
+            let k = law.stiffness(&w, 0.0, p);
+            assert!((k / (2.0 * KW * alpha) - 1.0).abs() < 1e-6, "{p}: {k}");
+        }
+        let hertz = ContactLaw::hertz(8.5e10).unwrap();
+        let d = hertz.overlap_for_force(&w, 0.0, 107.7e3);
+        let k = hertz.stiffness(&w, 0.0, 107.7e3);
+        assert!((k / (1.5 * 8.5e10 * d.sqrt()) - 1.0).abs() < 1e-6, "{k}");
     }
 }

@@ -173,17 +173,6 @@ fn at_level<R>(level: SimdLevel, f: impl FnOnce() -> R) -> R {
 /// (`examples/stability_limit.rs`).
 pub const CONTACT_STIFFNESS_MARGIN: f64 = 2.0;
 
-/// Stiffness `dP / d delta` (N/m) of contact law `law` on a perfect wheel of radius
-/// `radius` (m) at contact force `force` (N), by a central difference about the overlap
-/// that carries it; for the adaptive law it equals `2 K_w alpha_w`.
-pub fn contact_stiffness(law: &ContactLaw, radius: f64, force: f64) -> Result<f64> {
-    let wheel = WheelProfile::perfect(radius)?;
-    let delta = law.overlap_for_force(&wheel, 0.0, force);
-    let e = 1e-6 * delta;
-    let p = |d: f64| law.evaluate(&wheel, 0.0, d).force;
-    Ok((p(delta + e) - p(delta - e)) / (2.0 * e))
-}
-
 /// Time step used when the scenario asks for the default (`dt = 0`) (s), without the
 /// contact's stiffness ([`Simulation::new`] takes it into account; the two agree for
 /// every physical contact: see `docs/VALIDATION.md`).
@@ -230,7 +219,8 @@ impl Simulation {
         let critical = match &s.track {
             TrackSpec::Discrete(p) => {
                 p.validate()?;
-                let kc = contact_stiffness(&law, s.wheel_radius, force_limit(static_load))?;
+                let perfect = WheelProfile::perfect(s.wheel_radius)?;
+                let kc = law.stiffness(&perfect, 0.0, force_limit(static_load));
                 Some(p.critical_time_step_with_contact(CONTACT_STIFFNESS_MARGIN * kc))
             }
             TrackSpec::Lumped(_) => None,

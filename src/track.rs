@@ -875,6 +875,73 @@ fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     std::mem::swap(ph, ph_prev);
 }
 
+/// Growth of a perturbation of the rails under a linear contact spring, for measuring
+/// the stability threshold of the explicit scheme with the contact included
+/// (`docs/VALIDATION.md`, section 3; `examples/stability_limit.rs`).
+///
+/// The track (`params`, no stability check on `dt`) starts from a pseudo-random
+/// perturbation of every inner rail node (deflections of 1 um, rotations of 1 um / dx;
+/// the same every call) and is stepped `steps` times at `dt` (s) with the force
+/// `kc z_rail(x_w)` (N; `kc` in N/m) on the left rail under a wheel at
+/// `x_w = x + v t` (m), as the coupled step applies the contact force. Returns the
+/// largest `|Z|` and `|theta| dx` at the end over their largest at the start, infinite
+/// once a value is not finite; it stops early, checking every 1,000 steps, once the
+/// growth passes `stop`. Errors: the parameters' own ([`Track::new_without_stability_check`]).
+pub fn perturbation_growth(
+    params: TrackParams,
+    dt: f64,
+    kc: f64,
+    (x, v): (f64, f64),
+    steps: usize,
+    stop: f64,
+) -> Result<f64> {
+    let mut t = Track::new_without_stability_check(params, dt)?;
+    let nk = t.nodes();
+    let dx = params.dx();
+    // Deterministic pseudo-random start (xorshift), rail ends at zero.
+    let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut rnd = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let (mut z, mut th) = (vec![0.0; 2 * nk], vec![0.0; 2 * nk]);
+    for r in 0..2 {
+        for k in 1..nk - 1 {
+            z[r * nk + k] = 1e-6 * rnd();
+            th[r * nk + k] = 1e-6 / dx * rnd();
+        }
+    }
+    t.set_state(&z, &th, &z, &th);
+    let amp = |t: &Track| {
+        let mut a: f64 = 0.0;
+        for r in 0..2 {
+            for (z, th) in t.rail_z(r).into_iter().zip(t.rail_theta(r)) {
+                if !(z.is_finite() && th.is_finite()) {
+                    return f64::INFINITY;
+                }
+                a = a.max(z.abs()).max((th * dx).abs());
+            }
+        }
+        a
+    };
+    let a0 = amp(&t);
+    for j in 0..steps {
+        let xw = x + v * j as f64 * dt;
+        let force = kc * t.rail_z_at(0, xw);
+        t.step(&[PointLoad {
+            rail: 0,
+            position: xw,
+            force,
+        }]);
+        if j % 1000 == 999 && !(amp(&t) / a0 <= stop) {
+            break;
+        }
+    }
+    Ok(amp(&t) / a0)
+}
+
 impl Track {
     /// A track at rest and undeformed, stepped with `dt` (s). Refuses a step above
     /// the critical step with a message naming the limit.
@@ -1735,54 +1802,6 @@ mod tests {
         }
     }
 
-    /// Growth of the track stepped `steps` times at `dt` with a linear contact spring
-    /// `kc` (N/m) to ground under `x` on the left rail (the force `kc z_rail(x)`
-    /// applied each step as the coupled step applies the contact force), from a
-    /// pseudo-random perturbation: the largest |Z| (and |theta| dx) at the end over
-    /// the largest at the start; infinite once anything is not finite.
-    fn growth_with_contact_spring(p: TrackParams, dt: f64, kc: f64, x: f64, steps: usize) -> f64 {
-        let mut t = Track::new_unchecked(p, dt);
-        let nk = t.nodes();
-        let dx = p.dx();
-        let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        let (mut z, mut th) = (vec![0.0; 2 * nk], vec![0.0; 2 * nk]);
-        for r in 0..2 {
-            for k in 1..nk - 1 {
-                z[r * nk + k] = 1e-6 * rnd();
-                th[r * nk + k] = 1e-6 / dx * rnd();
-            }
-        }
-        t.set_state(&z, &th, &z, &th);
-        let amp = |t: &Track| {
-            let mut a: f64 = 0.0;
-            for r in 0..2 {
-                for (z, th) in t.rail_z(r).into_iter().zip(t.rail_theta(r)) {
-                    if !(z.is_finite() && th.is_finite()) {
-                        return f64::INFINITY;
-                    }
-                    a = a.max(z.abs()).max((th * dx).abs());
-                }
-            }
-            a
-        };
-        let a0 = amp(&t);
-        for _ in 0..steps {
-            let force = kc * t.rail_z_at(0, x);
-            t.step(&[PointLoad {
-                rail: 0,
-                position: x,
-                force,
-            }]);
-        }
-        amp(&t) / a0
-    }
-
     #[test]
     fn contact_spring_does_not_lower_the_critical_step() {
         // Table 4.4 contact (adaptive, K_w = 3.3443e10 N/m/rad, R_w = 0.475 m):
@@ -1810,9 +1829,11 @@ mod tests {
         let (dtc, _) = p.critical_time_step();
         let x = 15.0 * 0.685;
         for kc in [0.0, 5.736e9] {
-            let g = growth_with_contact_spring(p, 0.99 * dtc, kc, x, 40_000);
+            let g =
+                perturbation_growth(p, 0.99 * dtc, kc, (x, 0.0), 40_000, f64::INFINITY).unwrap();
             assert!(g < 10.0, "k_c = {kc}: {g}");
-            let g = growth_with_contact_spring(p, 1.01 * dtc, kc, x, 40_000);
+            let g =
+                perturbation_growth(p, 1.01 * dtc, kc, (x, 0.0), 40_000, f64::INFINITY).unwrap();
             assert!(g > 1e6, "k_c = {kc}: {g}");
         }
     }
@@ -1831,9 +1852,9 @@ mod tests {
         assert!(text.contains("contact stiffness 1.00e11 N/m"), "{text}");
         assert!(!text.contains("does not lower it"), "{text}");
         let x = 15.0 * 0.685;
-        let g = growth_with_contact_spring(p, 0.99 * dt, 1e11, x, 40_000);
+        let g = perturbation_growth(p, 0.99 * dt, 1e11, (x, 0.0), 40_000, f64::INFINITY).unwrap();
         assert!(g < 10.0, "{g}");
-        let g = growth_with_contact_spring(p, 1.02 * dt, 1e11, x, 40_000);
+        let g = perturbation_growth(p, 1.02 * dt, 1e11, (x, 0.0), 40_000, f64::INFINITY).unwrap();
         assert!(g > 1e6, "{g}");
     }
 

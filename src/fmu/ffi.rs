@@ -150,6 +150,20 @@ struct Inner {
 }
 
 impl Inner {
+    /// Puts `s` into the state `old` of this instance (already checked by
+    /// [`Inner::state`]), or into a new state whose address goes to `slot`.
+    fn store(&mut self, old: Option<usize>, s: Snapshot, slot: &mut fmi2FMUstate) {
+        match old.and_then(|key| self.states.get_mut(&key)) {
+            Some(b) => **b = s,
+            None => {
+                let b = Box::new(s);
+                let p = &*b as *const Snapshot as fmi2FMUstate;
+                self.states.insert(p as usize, b);
+                *slot = p;
+            }
+        }
+    }
+
     /// The state behind `p` when this instance handed it out and has not freed it;
     /// `p` itself is never dereferenced.
     fn state(&mut self, call: Call, what: &str, p: fmi2FMUstate) -> super::FmiResult<usize> {
@@ -757,19 +771,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
             Some(x.state(call, "*FMUstate", *slot)?)
         };
         let s = x.inst.get_state()?;
-        match old {
-            Some(key) => {
-                if let Some(b) = x.states.get_mut(&key) {
-                    **b = s;
-                }
-            }
-            None => {
-                let b = Box::new(s);
-                let p = &*b as *const Snapshot as fmi2FMUstate;
-                x.states.insert(p as usize, b);
-                *slot = p;
-            }
-        }
+        x.store(old, s, slot);
         Ok(())
     })
 }
@@ -890,19 +892,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         let bytes = slice(&mut x.inst, call, "serializedState", serializedState, size)?;
         let bytes: Vec<u8> = bytes.iter().map(|&b| b as u8).collect();
         let s = x.inst.deserialize(&bytes)?;
-        match old {
-            Some(key) => {
-                if let Some(b) = x.states.get_mut(&key) {
-                    **b = s;
-                }
-            }
-            None => {
-                let b = Box::new(s);
-                let p = &*b as *const Snapshot as fmi2FMUstate;
-                x.states.insert(p as usize, b);
-                *slot = p;
-            }
-        }
+        x.store(old, s, slot);
         Ok(())
     })
 }
