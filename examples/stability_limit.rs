@@ -65,7 +65,7 @@ fn exact_limit(p: TrackParams, kc: f64, x: f64) -> f64 {
 /// `x + v t` (m) on the left rail grows from a random perturbation by 1e6 within
 /// `steps` ([`perturbation_growth`]).
 fn unstable(p: TrackParams, dt: f64, kc: f64, x: f64, v: f64, steps: usize) -> bool {
-    !(perturbation_growth(p, dt, kc, (x, v), steps, 1e6).unwrap() <= 1e6)
+    perturbation_growth(p, dt, kc, (x, v), steps, 1e6).unwrap() > 1e6
 }
 
 /// Smallest `dt / dt_c` (reported) at which the stepper is unstable, to 1e-6, the

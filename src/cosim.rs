@@ -9,7 +9,9 @@
 //! [`crate::solver::Simulation`].
 
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MIN_DT_FRACTION, check, within};
+use crate::limits::{
+    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
+};
 use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
 use nalgebra::Vector6;
 
@@ -37,6 +39,9 @@ pub struct VehicleUnit {
     dt_base: f64,
     t0: f64,
     k: u64,
+    /// Communication time not yet stepped (s): steps shorter than
+    /// [`MIN_STEP_FRACTION`] of the base step are carried over to the next call.
+    pending: f64,
     force: [f64; 2],
     max_force: [f64; 2],
     min_force: [f64; 2],
@@ -81,6 +86,7 @@ impl VehicleUnit {
             dt_base: dt,
             t0: 0.0,
             k: 0,
+            pending: 0.0,
             force: [w, w],
             max_force: [w, w],
             min_force: [w, w],
@@ -105,6 +111,10 @@ impl VehicleUnit {
     /// Time (s).
     pub fn time(&self) -> f64 {
         self.t0 + self.k as f64 * self.vehicle.dt()
+    }
+    /// Communication time carried over to the next call, not yet stepped (s).
+    pub fn carried(&self) -> f64 {
+        self.pending
     }
     /// Axle rotation angle `V t / R_w` (rad) (2.17).
     pub fn rotation(&self) -> f64 {
@@ -145,41 +155,46 @@ impl VehicleUnit {
         Ok(())
     }
 
-    /// Number of steps a communication step `h` (s) takes: `ceil(h / dt_base)`, `h`
-    /// first reduced by `tolerance` (s), the rounding of the master's clock, so a step
-    /// that is a whole multiple of the base step up to that rounding takes exactly that
-    /// many steps.
+    /// Number of steps a communication step `h` (s) takes, with the time carried over
+    /// from earlier calls: `ceil((h + carried) / dt_base)`, first reduced by `tolerance`
+    /// (s), the rounding of the master's clock, so a step that is a whole multiple of the
+    /// base step up to that rounding takes exactly that many steps; 0 when the sum is
+    /// below [`MIN_STEP_FRACTION`] of the base step.
     pub fn steps_for(&self, h: f64, tolerance: f64) -> f64 {
-        ((h - tolerance) / self.dt_base).ceil().max(1.0)
+        let total = h + self.pending;
+        if total < MIN_STEP_FRACTION * self.dt_base {
+            0.0
+        } else {
+            ((total - tolerance) / self.dt_base).ceil().max(1.0)
+        }
     }
 
     /// Advances by a communication step `h` (s) with the contact forces held, in
-    /// [`VehicleUnit::steps_for`] steps. When `h` is that many steps of the step in use
-    /// to within `tolerance` (s), the steps are taken as they are; otherwise the step
-    /// changes to `h / n` (first-order accurate at the change; stable for any sequence
-    /// of changes, since every step stays below half the critical step).
+    /// [`VehicleUnit::steps_for`] equal steps. When they are that many steps of the step
+    /// in use to within `tolerance` (s), they are taken as they are; otherwise the step
+    /// changes to `(h + carried) / n`: first-order accurate at the change and stable for
+    /// any sequence of changes, since every step stays below half the critical step. A
+    /// step (with what was carried) shorter than [`MIN_STEP_FRACTION`] of the base step
+    /// is carried over to the next call instead: a step that short would round the
+    /// velocities away (ratios of consecutive steps of 5,000 let the vehicle sink
+    /// millimetres over minutes), so the model time lags the master's by at most that.
     ///
-    /// Errors: `h` not positive or below `1e-6` of the base step (a step that short
-    /// would round the velocities away); a vehicle displacement beyond
+    /// Errors: `h` not positive; a vehicle displacement beyond
     /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`] or a wheel beyond
     /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`Error::Diverged`]).
     pub fn advance(&mut self, h: f64, tolerance: f64) -> Result<()> {
         positive("communication step", h, "s")?;
-        if h < 1e-6 * self.dt_base {
-            return Err(out_of_range(
-                "communication step",
-                h,
-                format!(
-                    ">= 1e-6 solver.step = {} s (a shorter step rounds the velocities away)",
-                    num(1e-6 * self.dt_base)
-                ),
-            ));
-        }
         let n = self.steps_for(h, tolerance);
-        if (h - n * self.vehicle.dt()).abs() > tolerance {
+        let total = h + self.pending;
+        if n == 0.0 {
+            self.pending = total;
+            return Ok(());
+        }
+        self.pending = 0.0;
+        if (total - n * self.vehicle.dt()).abs() > tolerance {
             self.t0 = self.time();
             self.k = 0;
-            self.vehicle.change_dt(h / n)?;
+            self.vehicle.change_dt(total / n)?;
         }
         for i in 0..2 {
             self.max_force[i] = self.max_force[i].max(self.force[i]);
@@ -246,6 +261,7 @@ impl VehicleUnit {
         let mut v = vec![
             self.t0,
             self.k as f64,
+            self.pending,
             self.force[0],
             self.force[1],
             self.max_force[0],
@@ -260,44 +276,43 @@ impl VehicleUnit {
     /// Restores a state written by [`VehicleUnit::state_vector`] of a unit with the
     /// same parameters.
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        if v.len() != 21 {
+        if v.len() != 22 {
             return Err(out_of_range(
                 "vehicle unit state length",
                 v.len() as f64,
-                "21 values",
+                "22 values",
             ));
         }
         let count = |x: f64| (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0;
-        if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1])) {
+        let min_step = MIN_STEP_FRACTION * self.dt_base;
+        if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1]) && v[2] >= 0.0 && v[2] < min_step) {
             return Err(out_of_range(
                 "state: clock",
                 v[0],
-                "t0 finite and >= 0 s, step count a whole number in [0, 2^53)",
+                "t0 finite and >= 0 s, step count a whole number in [0, 2^53), carried time \
+                 below the least step",
             ));
         }
-        for &f in &v[2..8] {
+        for &f in &v[3..9] {
             if !within(f, 1e7) {
                 return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
             }
         }
-        let dt = v[8];
-        if !(dt >= 1e-6 * self.dt_base && dt <= self.dt_base) {
+        let dt = v[9];
+        if !(dt >= min_step && dt <= self.dt_base) {
             return Err(out_of_range(
                 "state: step",
                 dt,
-                format!(
-                    "{} s <= dt <= {} s",
-                    num(1e-6 * self.dt_base),
-                    num(self.dt_base)
-                ),
+                format!("{} s <= dt <= {} s", num(min_step), num(self.dt_base)),
             ));
         }
-        self.vehicle.set_state_vector(&v[8..])?;
+        self.vehicle.set_state_vector(&v[9..])?;
         self.t0 = v[0];
         self.k = v[1] as u64;
-        self.force = [v[2], v[3]];
-        self.max_force = [v[4], v[5]];
-        self.min_force = [v[6], v[7]];
+        self.pending = v[2];
+        self.force = [v[3], v[4]];
+        self.max_force = [v[5], v[6]];
+        self.min_force = [v[7], v[8]];
         self.check_states()
     }
 }

@@ -106,6 +106,21 @@ pub fn within(x: f64, limit: f64) -> bool {
     x.abs() <= limit
 }
 
+/// Deepest wheel flat (m), given or derived from its length (2.13, 2.15): flats worn in
+/// service are a few millimetres deep; at 20 mm the wheel would drop a fifth of the way
+/// to the displacement bound.
+pub const MAX_FLAT_DEPTH: f64 = 0.02;
+/// Largest static overlap of wheel and rail (m) under the static wheel load: a wheel on a
+/// rail overlaps about 0.1 mm (table 4.4: 0.11 mm); 5 mm is a contact too soft to be
+/// one.
+pub const MAX_STATIC_OVERLAP: f64 = 5e-3;
+/// Largest static deflection of a suspension stage (m) under its share of the weight:
+/// freight suspensions deflect some centimetres.
+pub const MAX_STATIC_DEFLECTION: f64 = 0.3;
+/// Most grid nodes per sleeper span: the grid study converges at 8 (docs/VALIDATION.md);
+/// 64 puts a node every 11 mm, finer than any contact patch.
+pub const MAX_NODES_PER_SPAN: usize = 64;
+
 /// A contact force above this many static wheel loads is reached by no physical run.
 pub const FORCE_LIMIT_FACTOR: f64 = 20.0;
 /// The static load the force limit is taken from is at least this (N), so an unloaded
@@ -128,15 +143,25 @@ pub const DISPLACEMENT_LIMIT: f64 = 0.1;
 /// reaches (static suspension deflections are some centimetres).
 pub const BODY_DISPLACEMENT_LIMIT: f64 = 1.0;
 
-/// The most track work one FMI call may do: internal steps times rail nodes. About two
-/// seconds on this project's machine (1 to 1.5 ns per rail node and step); 2e9 node
-/// steps are 4.1e6 steps (59 s of simulated time) on the default 30-span, n = 8 track.
-pub const MAX_NODE_STEPS_PER_CALL: f64 = 2e9;
+/// The most track work one FMI call may do: internal steps times rail nodes. About a
+/// second on this project's machine on the default track (1 to 1.5 ns per rail node and
+/// step), up to about three on the longest (cache misses); 5e8 node steps are 1.0e6
+/// steps (15 s of simulated time) on the default 30-span, n = 8 track.
+pub const MAX_NODE_STEPS_PER_CALL: f64 = 5e8;
+/// The most rail segments (`track.spans * track.nodes_per_span`) a track may have: the
+/// banded static solve of 1e5 segments takes about 75 MB at its peak (740 MB at 1e6,
+/// which aborts a host short of memory), and 1e5 is 12,500 spans at the default n = 8
+/// (8.6 km).
+pub const MAX_RAIL_SEGMENTS: usize = 100_000;
 /// The most vehicle steps one FMI call may do (RollPlaneVehicle; about 2 s).
 pub const MAX_VEHICLE_STEPS_PER_CALL: f64 = 2e7;
 /// The engine checks every state of the track and vehicle for the health bounds every
 /// this many steps (the contact forces, wheel and rail under the wheel every step).
 pub const HEALTH_CHECK_INTERVAL: u64 = 256;
+/// RollPlaneVehicle carries a communication step shorter than this fraction of its
+/// step over to the next call rather than stepping it (see
+/// [`crate::cosim::VehicleUnit::advance`]).
+pub const MIN_STEP_FRACTION: f64 = 1e-3;
 /// `solver.dt`, when given, must be at least this fraction of the critical step: a
 /// smaller step resolves nothing more and only multiplies the work.
 pub const MIN_DT_FRACTION: f64 = 1e-3;

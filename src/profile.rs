@@ -7,6 +7,7 @@
 //! `beta_0 - gamma` (2.17-2.21), wrapped into (-pi, pi].
 
 use crate::error::{Result, finite, out_of_range, positive};
+use crate::limits::MAX_FLAT_DEPTH;
 use std::f64::consts::PI;
 
 /// Wraps an angle (rad) into (-pi, pi].
@@ -439,6 +440,21 @@ fn validate_flat(radius: f64, spec: &FlatSpec, p: &str) -> Result<Option<Flat>> 
         (None, FlatShape::Haversine) => length * length / (16.0 * radius), // (2.15)
         (None, FlatShape::Chord) => chord_depth,
     };
+    if depth > MAX_FLAT_DEPTH {
+        let (name, value) = match depth_given {
+            Some(d) => (format!("{p}.depth"), d),
+            None => (format!("{p}.length"), length),
+        };
+        return Err(out_of_range(
+            &name,
+            value,
+            format!(
+                "a flat depth <= {MAX_FLAT_DEPTH} m (this one: {} m; wheel flats worn in \
+                 service are a few millimetres deep)",
+                crate::error::num(depth)
+            ),
+        ));
+    }
     let half_angle = match spec.shape {
         FlatShape::Haversine => length / (2.0 * radius),
         FlatShape::Chord => ((radius - depth) / radius).acos(),

@@ -8,8 +8,8 @@
 use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{
-    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MIN_DT_FRACTION,
-    force_limit, within,
+    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_STATIC_OVERLAP,
+    MIN_DT_FRACTION, force_limit, within,
 };
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
@@ -216,10 +216,30 @@ impl Simulation {
             }
             ContactModel::Hertz => ContactLaw::hertz(s.hertz_coefficient)?,
         };
+        // A contact so soft that the static load sinks the wheel far into the rail is not
+        // a wheel on a rail.
+        let load = static_load[0].max(static_load[1]);
+        let perfect = WheelProfile::perfect(s.wheel_radius)?;
+        let overlap = law.overlap_for_force(&perfect, 0.0, load);
+        if load > 0.0 && !within(overlap, MAX_STATIC_OVERLAP) {
+            let (name, value) = match (s.contact_model, s.kw > 0.0) {
+                (ContactModel::Adaptive, true) => ("contact.Kw", s.kw),
+                _ => ("contact.CH", s.hertz_coefficient),
+            };
+            return Err(out_of_range(
+                name,
+                value,
+                format!(
+                    "a contact that carries the static wheel load {} N with an overlap of at \
+                     most {MAX_STATIC_OVERLAP} m (this one: {} m; wheel on rail: about 0.1 mm)",
+                    num(load),
+                    num(overlap)
+                ),
+            ));
+        }
         let critical = match &s.track {
             TrackSpec::Discrete(p) => {
                 p.validate()?;
-                let perfect = WheelProfile::perfect(s.wheel_radius)?;
                 let kc = law.stiffness(&perfect, 0.0, force_limit(static_load));
                 Some(p.critical_time_step_with_contact(CONTACT_STIFFNESS_MARGIN * kc))
             }
@@ -312,8 +332,10 @@ impl Simulation {
             static_load,
             critical_step: critical.map_or(f64::NAN, |c| c.0),
             force_limit: force_limit(static_load),
-            max_force: [f64::NEG_INFINITY; 2],
-            min_force: [f64::INFINITY; 2],
+            // The extremes of no force at all: finite, so that a state saved before the
+            // first step serialises (f64::MIN and f64::MAX give way to any force).
+            max_force: [f64::MIN; 2],
+            min_force: [f64::MAX; 2],
             cached: Cell::new(None),
             latest: Sample::default(),
             simd: SimdLevel::detect(),
@@ -418,11 +440,13 @@ impl Simulation {
     pub fn contact_law(&self) -> &ContactLaw {
         &self.law
     }
-    /// Largest contact force per wheel since the start (N).
+    /// Largest contact force per wheel since the start (N); `f64::MIN` before the first
+    /// step.
     pub fn max_force(&self) -> [f64; 2] {
         self.max_force
     }
-    /// Smallest contact force per wheel since the start (N).
+    /// Smallest contact force per wheel since the start (N); `f64::MAX` before the
+    /// first step.
     pub fn min_force(&self) -> [f64; 2] {
         self.min_force
     }

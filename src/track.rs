@@ -18,7 +18,7 @@
 //! the compiler vectorises it.
 
 use crate::error::{Error, Result, out_of_range, positive};
-use crate::limits::check;
+use crate::limits::{MAX_NODES_PER_SPAN, MAX_RAIL_SEGMENTS, check};
 use nalgebra::{DMatrix, DVector, Matrix4, SymmetricEigen};
 
 /// Rail cross-section data for the Timoshenko beam.
@@ -115,18 +115,23 @@ impl TrackParams {
         if self.spans < 2 {
             return Err(out_of_range("track.spans", self.spans as f64, ">= 2"));
         }
-        if self.nodes_per_span < 1 {
+        if !(1..=MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
             return Err(out_of_range(
                 "track.nodes_per_span",
                 self.nodes_per_span as f64,
-                ">= 1",
+                format!("1 <= track.nodes_per_span <= {MAX_NODES_PER_SPAN}"),
             ));
         }
-        if self.spans * self.nodes_per_span > 1_000_000 {
+        if self.spans.saturating_mul(self.nodes_per_span) > MAX_RAIL_SEGMENTS {
             return Err(out_of_range(
                 "track.spans",
                 self.spans as f64,
-                "spans * nodes_per_span <= 1e6",
+                format!(
+                    "track.spans * track.nodes_per_span <= {MAX_RAIL_SEGMENTS} (here \
+                     track.nodes_per_span = {}): the static solve of a longer grid needs \
+                     more than about 100 MB",
+                    self.nodes_per_span
+                ),
             ));
         }
         check("track.sleeper_spacing", self.sleeper_spacing)?;
@@ -935,7 +940,7 @@ pub fn perturbation_growth(
             position: xw,
             force,
         }]);
-        if j % 1000 == 999 && !(amp(&t) / a0 <= stop) {
+        if j % 1000 == 999 && amp(&t) / a0 > stop {
             break;
         }
     }

@@ -11,7 +11,7 @@
 //! Roll angles are positive when they raise the right side (MODEL.md).
 
 use crate::error::{Error, Result, non_negative, out_of_range, positive};
-use crate::limits::check;
+use crate::limits::{MAX_STATIC_DEFLECTION, check};
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 /// Parameters of the roll-plane vehicle (table 4.4 names).
@@ -65,6 +65,32 @@ impl RollPlaneParams {
             ("gravity", self.gravity),
         ] {
             check(name, value)?;
+        }
+        // Static deflection of each stage under its share of the weight, per side.
+        let g = self.gravity;
+        let secondary = 0.5 * (self.carbody_mass + self.bolster_mass) * g;
+        let primary = secondary + self.sideframe_mass * g;
+        for (name, k, load) in [
+            (
+                "vehicle.secondary.stiffness",
+                self.secondary_stiffness,
+                secondary,
+            ),
+            ("vehicle.primary.stiffness", self.primary_stiffness, primary),
+        ] {
+            if load / k > MAX_STATIC_DEFLECTION {
+                return Err(out_of_range(
+                    name,
+                    k,
+                    format!(
+                        ">= {} N/m: it deflects {} m under its static load of {} N per side \
+                         (allowed: up to {MAX_STATIC_DEFLECTION} m)",
+                        crate::error::num(load / MAX_STATIC_DEFLECTION),
+                        crate::error::num(load / k),
+                        crate::error::num(load)
+                    ),
+                ));
+            }
         }
         Ok(())
     }

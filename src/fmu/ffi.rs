@@ -12,8 +12,8 @@ use std::cell::UnsafeCell;
 use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock};
 
 /// `fmi2Component`: pointer to an instance (behind its busy flag).
 pub type fmi2Component = *mut c_void;
@@ -361,24 +361,23 @@ pub fn kind_of_binary(path: &str) -> Option<Kind> {
 
 /// Path of the loaded object that holds this code (the FMU's shared library, or the
 /// executable that links the crate), from the dynamic loader.
-pub fn loaded_binary() -> Option<&'static str> {
-    static PATH: OnceLock<Option<String>> = OnceLock::new();
-    PATH.get_or_init(|| {
-        #[cfg(unix)]
-        {
-            let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
-            let addr = fmi2Instantiate as *const c_void;
-            if unsafe { libc::dladdr(addr, &mut info) } != 0 && !info.dli_fname.is_null() {
-                return c_str(info.dli_fname);
-            }
-            None
+///
+/// Asked at every `fmi2Instantiate` rather than cached: a cached copy would outlive an
+/// unloaded library (a leak per `dlopen`/`dlclose`).
+pub fn loaded_binary() -> Option<String> {
+    #[cfg(unix)]
+    {
+        let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
+        let addr = fmi2Instantiate as *const c_void;
+        if unsafe { libc::dladdr(addr, &mut info) } != 0 && !info.dli_fname.is_null() {
+            return c_str(info.dli_fname);
         }
-        #[cfg(not(unix))]
-        {
-            None
-        }
-    })
-    .as_deref()
+        None
+    }
+    #[cfg(not(unix))]
+    {
+        None
+    }
 }
 
 /// The FMU a GUID instantiates in a binary of `binary` (see [`kind_of_binary`]): only
@@ -506,7 +505,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
             ));
         }
         let guid = c_str(fmuGUID).unwrap_or_default();
-        let binary = loaded_binary().and_then(kind_of_binary);
+        let binary = loaded_binary().as_deref().and_then(kind_of_binary);
         let kind = match kind_for_guid(binary, &guid) {
             Ok(k) => k,
             Err(m) => return fail(format!("fmi2Instantiate: {m}")),
@@ -1112,6 +1111,6 @@ mod tests {
         );
         // Tests link the crate into their own executable: not an FMU binary.
         let exe = loaded_binary().expect("dladdr names the executable");
-        assert_eq!(kind_of_binary(exe), None, "{exe}");
+        assert_eq!(kind_of_binary(&exe), None, "{exe}");
     }
 }

@@ -342,6 +342,8 @@ pub struct Instance {
     /// Why the run cannot go on (a value beyond the health bounds): `fmi2DoStep` and
     /// outputs are refused until `fmi2Reset` or `fmi2SetFMUstate`.
     failed: Option<String>,
+    /// The warning that the wheel nears the fixed rail end was given.
+    end_warned: bool,
     logger: Logger,
     logging_on: bool,
     categories: [bool; 4],
@@ -357,6 +359,11 @@ impl std::fmt::Debug for Instance {
             .finish()
     }
 }
+
+/// The zone at the fixed rail end, in sleeper spans, where [`Instance::do_step`] warns
+/// that the end's reflections raise the forces (the default start position, 1.37 m, is
+/// two spans from the other end).
+pub const END_ZONE_SPANS: f64 = 2.0;
 
 /// Value references of the flats `[side][k]`: length, depth, angle, shape.
 const FLAT_VRS: [[[u32; 4]; 4]; 2] = [
@@ -438,6 +445,7 @@ impl Instance {
             stop_time: None,
             ended: false,
             failed: None,
+            end_warned: false,
             logger,
             logging_on,
             categories: [true; 4],
@@ -702,6 +710,7 @@ impl Instance {
         self.stop_time = None;
         self.ended = false;
         self.failed = None;
+        self.end_warned = false;
         self.published = Published::default();
         Ok(())
     }
@@ -956,6 +965,14 @@ impl Instance {
                 Causality::Output | Causality::CalculatedParameter
             );
         }
+        if needs_model && self.phase == Phase::Error && self.failed.is_none() {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: no outputs: an internal error stopped the instance; call fmi2Reset"
+                ),
+            );
+        }
         if needs_model {
             if let Some(why) = &self.failed {
                 let m = format!(
@@ -1125,8 +1142,12 @@ impl Instance {
                 return self.refuse(
                     Status::Error,
                     format!(
-                        "{call}: `{}` = {x}{unit} is out of range; allowed: finite, {} <= {} <= {}{unit}",
-                        s.name, s.min, s.name, s.max
+                        "{call}: `{}` = {}{unit} is out of range; allowed: finite, {} <= {} <= {}{unit}",
+                        s.name,
+                        num(x),
+                        num(s.min),
+                        s.name,
+                        num(s.max)
                     ),
                 );
             }
@@ -1219,13 +1240,17 @@ impl Instance {
                 format!("fmi2DoStep: communicationStepSize = {h} s; allowed: finite and > 0 s"),
             );
         }
-        let tol = 1e-9 * (1.0 + self.time.abs());
+        // The master's clock may differ from `t + h` of the last call by its rounding.
+        let tol = 64.0 * f64::EPSILON * t.abs().max(self.time.abs());
         if !t.is_finite() || (t - self.time).abs() > tol {
             return self.refuse(
                 Status::Error,
                 format!(
-                    "fmi2DoStep: currentCommunicationPoint = {t} s, but the FMU is at {} s",
-                    self.time
+                    "fmi2DoStep: currentCommunicationPoint = {t} s, but the FMU is at {} s \
+                     (the end of the last step; allowed: that time to within {} s, the \
+                     rounding of the clock)",
+                    self.time,
+                    num(tol)
                 ),
             );
         }
@@ -1296,17 +1321,53 @@ impl Instance {
             None => Err(Error::Unsupported("stepping before initialisation".into())),
         };
         if let Err(e) = r {
-            if matches!(e, Error::OffTrack { .. }) {
-                self.ended = true;
-                self.phase = Phase::StepFailed;
-            } else {
-                self.failed = Some(e.to_string());
-                self.phase = Phase::Error;
+            match e {
+                Error::OffTrack { .. } => {
+                    self.ended = true;
+                    self.phase = Phase::StepFailed;
+                }
+                // The state may be partly advanced and beyond the health bounds.
+                Error::Diverged { .. } | Error::NonFinite { .. } => {
+                    self.failed = Some(e.to_string());
+                    self.phase = Phase::Error;
+                }
+                // Refused arguments: nothing moved.
+                _ => {}
             }
             return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
+        self.warn_near_track_end();
         Ok(())
+    }
+
+    /// Warns once per run when the wheel comes within [`END_ZONE_SPANS`] sleeper spans of
+    /// the fixed rail end, where the end's reflections raise the impact forces (by 20 to
+    /// 35 % within the last span, table 4.4).
+    fn warn_near_track_end(&mut self) {
+        if self.end_warned {
+            return;
+        }
+        let Some(Model::Sim(sim)) = &self.model else {
+            return;
+        };
+        let TrackSpec::Discrete(p) = &sim.scenario().track else {
+            return;
+        };
+        let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
+        let x = sim.position();
+        if x > zone {
+            self.end_warned = true;
+            let m = format!(
+                "fmi2DoStep: at t = {} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} \
+                 sleeper spans of the fixed rail end at {:.3} m: the end's reflections raise \
+                 impact forces here (by 20 to 35 % within the last span); keep the impacts \
+                 of interest at least {END_ZONE_SPANS} spans from the ends (track.spans)",
+                self.time,
+                p.length()
+            );
+            self.log(Status::Warning, "logStatusWarning", &m);
+        }
     }
 
     /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
@@ -1510,12 +1571,40 @@ impl Instance {
             let saved = std::mem::replace(&mut self.values, values.clone());
             let built = self.build();
             self.values = saved;
-            let (mut m, _) = built.map_err(|e| format!("stored parameters refused: {e}"))?;
+            let (mut m, rebuilt) = built.map_err(|e| format!("stored parameters refused: {e}"))?;
+            let again = [
+                rebuilt.static_load[0],
+                rebuilt.static_load[1],
+                rebuilt.static_wheel_z[0],
+                rebuilt.static_wheel_z[1],
+                rebuilt.step,
+                rebuilt.critical_step,
+                rebuilt.kw_used,
+            ];
+            if let Some(k) = (0..7).find(|&k| again[k].to_bits() != pubs[k].to_bits()) {
+                return Err(format!(
+                    "stored calculated parameter {k} = {} disagrees with the {} the stored \
+                     parameters give",
+                    pubs[k], again[k]
+                ));
+            }
             match &mut m {
                 Model::Vehicle(u) => u.set_state_vector(&state),
                 Model::Sim(sim) => sim.set_state_vector(&state),
             }
             .map_err(|e| e.to_string())?;
+            // The model's clock must be the stored communication time's.
+            let (model_time, slack) = match &m {
+                Model::Vehicle(u) => (u.time() + u.carried(), 0.0),
+                Model::Sim(sim) => (sim.time(), 0.5 * sim.dt()),
+            };
+            let off = (start_time + model_time - time).abs();
+            if off.is_nan() || off > slack + 1e-9 * (1.0 + time.abs()) {
+                return Err(format!(
+                    "stored time {time} s disagrees with the model's clock {} s",
+                    start_time + model_time
+                ));
+            }
             Some(m)
         } else {
             None
@@ -1565,8 +1654,12 @@ struct Cursor<'a> {
 
 impl<'a> Cursor<'a> {
     fn take(&mut self, n: usize) -> std::result::Result<&'a [u8], String> {
-        if self.at + n > self.b.len() {
-            return Err(format!("truncated at byte {}", self.at));
+        if n > self.b.len() - self.at {
+            return Err(format!(
+                "truncated at byte {} ({n} bytes announced, {} left)",
+                self.at,
+                self.b.len() - self.at
+            ));
         }
         let s = &self.b[self.at..self.at + n];
         self.at += n;
@@ -2044,9 +2137,17 @@ mod tests {
         // The instances go on after a refused step.
         tc.do_step(0.0, 1e-3).unwrap();
         v.do_step(0.0, 1e-3).unwrap();
-        // A vehicle step below 1e-6 of its step would round the velocities away.
-        let e = v.do_step(1e-3, 1e-12).unwrap_err();
-        assert!(e.message.contains("communication step"), "{}", e.message);
+        // A vehicle step below 1e-3 of its step is carried over to the next call (it
+        // would round the velocities away); the outputs stay as they were.
+        let mut before = [0.0; 2];
+        v.get_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_ROTATION], &mut before)
+            .unwrap();
+        v.do_step(1e-3, 1e-12).unwrap();
+        let mut after = [0.0; 2];
+        v.get_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_ROTATION], &mut after)
+            .unwrap();
+        assert_eq!(before, after);
+        v.do_step(1e-3 + 1e-12, 1e-3).unwrap();
         // solver.dt far below the critical step is refused at initialisation.
         for kind in [
             Kind::TrackContact,
@@ -2175,5 +2276,126 @@ mod tests {
         );
         assert!(log[0].contains("t = 0.986"), "{}", log[0]);
         assert!(log[0].contains("track.spans >= 61"), "{}", log[0]);
+    }
+
+    #[test]
+    fn the_communication_point_must_be_the_fmu_time_to_the_clock_rounding() {
+        // At t = 1e9 s a tolerance relative to 1 + |t| let 0.5 s jumps and steps back
+        // through with fmi2OK.
+        let (mut i, _) = instance(Kind::CoupledSystem);
+        i.setup_experiment(1e9, None).unwrap();
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        for t in [1e9 + 0.5, 1e9 - 0.4, 1e9 + 1e-4] {
+            let e = i.do_step(t, 1e-4).unwrap_err();
+            assert!(e.message.contains("but the FMU is at"), "{}", e.message);
+        }
+        // A few units in the last place are the master's rounding.
+        i.do_step(1e9 + 2.0 * 1.2e-7, 1e-4).unwrap();
+        assert_eq!(i.phase(), Phase::StepComplete);
+    }
+
+    #[test]
+    fn contacts_and_suspensions_too_soft_to_carry_the_load_are_refused_at_initialisation() {
+        let cases: [(Kind, u32, f64, &str); 4] = [
+            (Kind::CoupledSystem, vr::CONTACT_CH, 1.0, "`contact.CH`"),
+            (Kind::TrackContact, vr::CONTACT_KW, 1e6, "`contact.Kw`"),
+            (
+                Kind::CoupledSystem,
+                vr::VEHICLE_PRIMARY_STIFFNESS,
+                1e4,
+                "`vehicle.primary.stiffness`",
+            ),
+            (
+                Kind::RollPlaneVehicle,
+                vr::VEHICLE_SECONDARY_STIFFNESS,
+                1e4,
+                "`vehicle.secondary.stiffness`",
+            ),
+        ];
+        for (kind, r, x, name) in cases {
+            let (mut i, log) = instance(kind);
+            if r == vr::CONTACT_CH {
+                i.set_integer(&[vr::CONTACT_MODEL], &[2]).unwrap();
+            }
+            i.set_real(&[r], &[x]).unwrap();
+            i.enter_initialization().unwrap();
+            let e = i.exit_initialization().unwrap_err();
+            assert!(e.message.contains(name), "{}", e.message);
+            assert_eq!(log.lock().unwrap().len(), 1);
+        }
+        // The longest chord flat would be 139 mm deep.
+        let (mut i, _) = instance(Kind::CoupledSystem);
+        i.set_integer(&[vr::FLAT_LEFT_1_SHAPE], &[2]).unwrap();
+        i.set_real(
+            &[vr::FLAT_LEFT_1_DEPTH, vr::FLAT_LEFT_1_LENGTH],
+            &[0.0, 0.746],
+        )
+        .unwrap();
+        i.enter_initialization().unwrap();
+        let e = i.exit_initialization().unwrap_err();
+        assert!(e.message.contains("`flat.left[1].length`"), "{}", e.message);
+    }
+
+    #[test]
+    fn a_state_saved_before_the_first_step_restores_in_a_fresh_instance() {
+        for kind in [
+            Kind::TrackContact,
+            Kind::RollPlaneVehicle,
+            Kind::CoupledSystem,
+        ] {
+            let (mut a, _) = instance(kind);
+            a.enter_initialization().unwrap();
+            a.exit_initialization().unwrap();
+            let state = a.get_state().unwrap();
+            let bytes = a.serialize(&state).unwrap();
+            let (mut b, _) = instance(kind);
+            let s = b.deserialize(&bytes).unwrap();
+            b.set_state(&s).unwrap();
+            for i in [&mut a, &mut b] {
+                i.do_step(0.0, 1e-3).unwrap();
+            }
+            let (mut x, mut y) = ([0.0; 2], [0.0; 2]);
+            let vrs = [vr::WHEEL_LEFT_Z, vr::CONTACT_LEFT_MAX_FORCE];
+            a.get_real(&vrs, &mut x).unwrap();
+            b.get_real(&vrs, &mut y).unwrap();
+            assert_eq!(x, y, "{kind:?}");
+        }
+    }
+
+    #[test]
+    fn a_doctored_state_is_refused_and_leaves_the_instance_as_it_was() {
+        let (mut i, _) = instance(Kind::CoupledSystem);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 1e-3).unwrap();
+        let state = i.get_state().unwrap();
+        let b = i.serialize(&state).unwrap();
+        let guid = i.kind.table().guid.len();
+        let time_at = MAGIC.len() + 8 + guid + 3;
+        let put = |at: usize, bytes: &[u8]| {
+            let mut c = b.clone();
+            c[at..at + bytes.len()].copy_from_slice(bytes);
+            c
+        };
+        for (bytes, why) in [
+            // the GUID's and the reason's lengths at their largest
+            (put(MAGIC.len(), &u64::MAX.to_le_bytes()), "truncated"),
+            (put(time_at + 16, &u64::MAX.to_le_bytes()), "truncated"),
+            // solver.step (the fifth calculated parameter) and the clock
+            (
+                put(time_at + 24 + 4 * 8, &1e300f64.to_le_bytes()),
+                "disagrees",
+            ),
+            (
+                put(time_at, &0.5f64.to_le_bytes()),
+                "disagrees with the model's clock",
+            ),
+        ] {
+            let e = i.deserialize(&bytes).unwrap_err();
+            assert!(e.message.contains(why), "{why}: {}", e.message);
+        }
+        assert_eq!(i.phase(), Phase::StepComplete);
+        i.do_step(1e-3, 1e-3).unwrap();
     }
 }
