@@ -48,8 +48,8 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("contact.CH", 0.0, 1e13, "N/m^1.5"),
     r("track.sleeper_spacing", 0.1, 3.0, "m"),
     r("track.rail_seat_distance", 0.3, 3.0, "m"),
-    r("track.rail.EI", 1e4, 1e9, "N m^2"),
-    r("track.rail.kAG", 1e6, 1e11, "N"),
+    r("track.rail.EI", 3e5, 1e9, "N m^2"),
+    r("track.rail.kAG", 1e7, 1e11, "N"),
     r("track.rail.mass", 5.0, 500.0, "kg/m"),
     r("track.rail.rotary_inertia", 1e-4, 100.0, "kg m"),
     r("track.pad.stiffness", 0.0, 1e11, "N/m"),
@@ -114,6 +114,10 @@ pub const MAX_FLAT_DEPTH: f64 = 0.02;
 /// rail overlaps about 0.1 mm (table 4.4: 0.11 mm); 5 mm is a contact too soft to be
 /// one.
 pub const MAX_STATIC_OVERLAP: f64 = 5e-3;
+/// Largest static deflection of the rail under the wheel (m) under the static wheel
+/// load: table 4.4's track deflects 1.3 mm; 10 mm is a track too soft to carry a
+/// train.
+pub const MAX_STATIC_RAIL_DEFLECTION: f64 = 0.01;
 /// Largest static deflection of a suspension stage (m) under its share of the weight:
 /// freight suspensions deflect some centimetres.
 pub const MAX_STATIC_DEFLECTION: f64 = 0.3;

@@ -9,7 +9,7 @@ use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{
     BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_STATIC_OVERLAP,
-    MIN_DT_FRACTION, force_limit, within,
+    MAX_STATIC_RAIL_DEFLECTION, MIN_DT_FRACTION, force_limit, within,
 };
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
@@ -341,6 +341,37 @@ impl Simulation {
             simd: SimdLevel::detect(),
         };
         sim.set_static()?;
+        if let (TrackSpec::Discrete(p), TrackState::Discrete(_)) = (&s.track, &sim.track) {
+            let z = sim.rail_z();
+            let sag = z[0].abs().max(z[1].abs());
+            if !within(sag, MAX_STATIC_RAIL_DEFLECTION) {
+                // Named: the support softest against table 4.4's (pads 140 MN/m, ballast
+                // 40 MN/m); the message gives all that carry the load.
+                let (name, value) = if p.ballast_stiffness / 40e6 < p.pad_stiffness / 140e6 {
+                    ("track.ballast.stiffness", p.ballast_stiffness)
+                } else {
+                    ("track.pad.stiffness", p.pad_stiffness)
+                };
+                return Err(out_of_range(
+                    name,
+                    value,
+                    format!(
+                        "a track that carries the static wheel load {} N with a rail deflection \
+                         of at most {MAX_STATIC_RAIL_DEFLECTION} m (this one: {} m with \
+                         track.pad.stiffness = {} N/m, track.ballast.stiffness = {} N/m, \
+                         track.rail.EI = {} N m^2, track.rail.kAG = {} N, track.sleeper_spacing \
+                         = {} m; table 4.4: 1.3 mm)",
+                        num(load),
+                        num(sag),
+                        num(p.pad_stiffness),
+                        num(p.ballast_stiffness),
+                        num(p.rail.ei),
+                        num(p.rail.kag),
+                        num(p.sleeper_spacing)
+                    ),
+                ));
+            }
+        }
         sim.check_states()?;
         Ok(sim)
     }
@@ -967,6 +998,12 @@ impl Simulation {
     /// limit, the force extremes finite.
     pub fn check_health(&self) -> Result<()> {
         self.check_states()?;
+        self.check_sample()
+    }
+
+    /// The sample part of [`Simulation::check_health`]: cheap (the sample is cached and
+    /// used by the next step).
+    pub fn check_sample(&self) -> Result<()> {
         let s = self.sample();
         let lim = self.force_limit;
         for (what, x, limit) in [

@@ -1293,13 +1293,19 @@ impl Track {
                 }
             }
         }
-        let x = self
-            .solve_static_banded(f.as_slice())
-            .ok_or_else(|| Error::NonFinite {
-                what: "static track solution (singular stiffness: check pad and ballast stiffness)"
-                    .into(),
-                time: 0.0,
-            })?;
+        let x = self.solve_static_banded(f.as_slice()).ok_or_else(|| {
+            out_of_range(
+                "track.pad.stiffness",
+                self.params.pad_stiffness,
+                format!(
+                    "a track whose pads and ballast hold the rails (static solve singular \
+                         with track.pad.stiffness = {} N/m and track.ballast.stiffness = {} \
+                         N/m: give both > 0)",
+                    crate::error::num(self.params.pad_stiffness),
+                    crate::error::num(self.params.ballast_stiffness)
+                ),
+            )
+        })?;
         let xs = x.as_slice();
         Self::from_nodes(&self.slot, sp, &xs[..2 * nk], &mut self.z);
         Self::from_nodes(&self.slot, sp, &xs[2 * nk..4 * nk], &mut self.th);

@@ -1002,18 +1002,27 @@ impl Instance {
             }
             if computed && s.unit == "N" && o.is_finite() {
                 let (name, x) = (s.name, *o);
-                return self.refuse(
-                    Status::Error,
-                    format!(
-                        "{call}: `{name}` = {} N at t = {} s is beyond {} N ({} times the static \
-                         wheel load), which no physical run reaches: likely the wheel inputs \
-                         press the wheel into the rail far beyond a running wheel's overlap",
-                        num(x),
-                        self.time,
-                        num(lim),
-                        crate::limits::FORCE_LIMIT_FACTOR
-                    ),
+                let cause = match self.kind {
+                    Kind::TrackContact => {
+                        "likely the wheel inputs press the wheel into the rail far beyond a \
+                         running wheel's overlap"
+                    }
+                    _ => "the run diverged, or its parameters are far from a railway",
+                };
+                let why = format!(
+                    "`{name}` = {} N at t = {} s is beyond {} N ({} times the static wheel \
+                     load), which no physical run reaches: {cause}",
+                    num(x),
+                    self.time,
+                    num(lim),
+                    crate::limits::FORCE_LIMIT_FACTOR
                 );
+                // Only TrackContact's outputs can come back with other inputs.
+                if self.kind != Kind::TrackContact {
+                    self.failed = Some(why.clone());
+                    self.phase = Phase::Error;
+                }
+                return self.refuse(Status::Error, format!("{call}: {why}"));
             }
             if !o.is_finite() {
                 let (name, x) = (s.name, *o);
@@ -1255,6 +1264,10 @@ impl Instance {
             );
         }
         let end = t + h;
+        let start = self.start_time;
+        // The vehicle steps to the master's clock, not by the sum of the h it was given
+        // (which drifts from the clock by its rounding, 1e-7 s per call at 1e9 s).
+        let vehicle_step = |u: &VehicleUnit, end: f64| (end - start) - (u.time() + u.carried());
         if end == t {
             return self.refuse(
                 Status::Error,
@@ -1281,7 +1294,7 @@ impl Instance {
                 let target = ((end - self.start_time) / sim.dt()).round().max(0.0);
                 (target - sim.steps() as f64).max(0.0)
             }
-            Some(Model::Vehicle(u)) => u.steps_for(h, clock),
+            Some(Model::Vehicle(u)) => u.steps_for(vehicle_step(u, end), clock),
             None => 0.0,
         };
         let work = match &self.model {
@@ -1317,7 +1330,10 @@ impl Instance {
         }
         let r = match &mut self.model {
             Some(Model::Sim(sim)) => sim.advance_steps(n as u64),
-            Some(Model::Vehicle(u)) => u.advance(h, clock),
+            Some(Model::Vehicle(u)) => {
+                let h = vehicle_step(u, end);
+                if h > 0.0 { u.advance(h, clock) } else { Ok(()) }
+            }
             None => Err(Error::Unsupported("stepping before initialisation".into())),
         };
         if let Err(e) = r {
@@ -1337,6 +1353,15 @@ impl Instance {
             return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
+        // CoupledSystem has no inputs: the sample at the end of the step is final (and
+        // cached for the next step), so a value beyond the bounds there fails this step.
+        if let (Kind::CoupledSystem, Some(Model::Sim(sim))) = (self.kind, &self.model)
+            && let Err(e) = sim.check_sample()
+        {
+            self.failed = Some(e.to_string());
+            self.phase = Phase::Error;
+            return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
+        }
         self.warn_near_track_end();
         Ok(())
     }
@@ -1564,8 +1589,13 @@ impl Instance {
         if r.at != bytes.len() {
             return Err(format!("{} trailing bytes", bytes.len() - r.at));
         }
+        // A stopped run's model state is beyond the health bounds by definition, and
+        // nothing can be read from it or stepped: it is restored as the stopped run
+        // without a model (fmi2Reset or another state goes on from there).
+        let stopped = phase == Phase::Error;
+        let state = if stopped { Vec::new() } else { state };
         self.check_stored((time, start_time), &pubs, &values, &state)?;
-        let model = if has_model {
+        let model = if has_model && !stopped {
             // Build with the stored parameters on a scratch instance, then overwrite
             // the dynamic state.
             let saved = std::mem::replace(&mut self.values, values.clone());
@@ -2397,5 +2427,97 @@ mod tests {
         }
         assert_eq!(i.phase(), Phase::StepComplete);
         i.do_step(1e-3, 1e-3).unwrap();
+    }
+
+    #[test]
+    fn a_coupled_run_beyond_the_bounds_fails_the_step_that_got_there() {
+        // A contact 300 times stiffer than table 4.4's on a shear-soft rail: the first
+        // impact passes 20 times the static load. The step that ends there returns
+        // fmi2Error naming the force and not blaming inputs CoupledSystem has none of;
+        // the stopped run's state serialises and restores as stopped.
+        let (mut i, _) = instance(Kind::CoupledSystem);
+        i.set_integer(&[vr::TRACK_SPANS], &[60]).unwrap();
+        i.set_real(
+            &[vr::CONTACT_KW, vr::CONTACT_CH, vr::TRACK_RAIL_KAG],
+            &[1e13, 0.0, 1e7],
+        )
+        .unwrap();
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        let h = 1e-3;
+        let mut k = 0;
+        let e = loop {
+            match i.do_step(k as f64 * h, h) {
+                Ok(()) => {
+                    let mut p = [0.0];
+                    i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+                    assert!(p[0] < 20.0 * 107.7e3);
+                }
+                Err(e) => break e,
+            }
+            k += 1;
+            assert!(k < 100, "no impact beyond the bound");
+        };
+        assert!(
+            e.message.contains("contact.left.force (N)"),
+            "{}",
+            e.message
+        );
+        assert!(!e.message.contains("wheel inputs"), "{}", e.message);
+        assert_eq!(i.phase(), Phase::Error);
+        let state = i.get_state().unwrap();
+        let bytes = i.serialize(&state).unwrap();
+        let (mut fresh, _) = instance(Kind::CoupledSystem);
+        let restored = fresh.deserialize(&bytes).unwrap();
+        fresh.set_state(&restored).unwrap();
+        assert_eq!(fresh.phase(), Phase::Error);
+        let mut p = [0.0];
+        let e = fresh
+            .get_real(&[vr::CONTACT_LEFT_FORCE], &mut p)
+            .unwrap_err();
+        assert!(e.message.contains("the run stopped"), "{}", e.message);
+        fresh.reset().unwrap();
+        fresh.enter_initialization().unwrap();
+        fresh.exit_initialization().unwrap();
+    }
+
+    #[test]
+    fn the_vehicle_follows_the_masters_clock_far_from_zero() {
+        // At t = 1e9 s each t + 1e-3 rounds by up to 6e-8 s; summing the h given drifted
+        // 1e-3 s from the clock over 2e4 calls.
+        let (mut v, _) = instance(Kind::RollPlaneVehicle);
+        v.setup_experiment(1e9, None).unwrap();
+        v.enter_initialization().unwrap();
+        v.exit_initialization().unwrap();
+        let mut t = 1e9;
+        for _ in 0..20_000 {
+            let next = t + 1e-3;
+            v.do_step(t, next - t).unwrap();
+            t = next;
+        }
+        let mut rot = [0.0];
+        v.get_real(&[vr::WHEEL_ROTATION], &mut rot).unwrap();
+        let model_time = rot[0] * 0.475 / (70.0 / 3.6);
+        let dt = v.published.step;
+        assert!(
+            (model_time - (t - 1e9)).abs() <= 1e-3 * dt + 1e-9,
+            "{model_time} against {}",
+            t - 1e9
+        );
+    }
+
+    #[test]
+    fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
+        let (mut i, log) = instance(Kind::TrackContact);
+        i.set_real(&[vr::TRACK_BALLAST_STIFFNESS], &[0.0]).unwrap();
+        i.enter_initialization().unwrap();
+        let e = i.exit_initialization().unwrap_err();
+        assert!(
+            e.message.contains("`track.ballast.stiffness` = 0"),
+            "{}",
+            e.message
+        );
+        assert!(e.message.contains("rail deflection"), "{}", e.message);
+        assert_eq!(log.lock().unwrap().len(), 1);
     }
 }
