@@ -381,19 +381,27 @@ mod tests {
         assert!(peak > 300e3, "peak {peak}");
     }
 
-    #[test]
-    fn state_vector_round_trip_continues_identically() {
-        let s = Scenario::table_4_4();
-        let VehicleSpec::RollPlane(vp) = s.vehicle else {
+    /// Table 4.4's vehicle at 20 m/s with step `dt` (0: the default) at rest on
+    /// `static_wheel_z`.
+    fn table_4_4_unit(
+        dt: impl Fn(&RollPlaneParams) -> f64,
+        static_wheel_z: [f64; 2],
+    ) -> VehicleUnitParams {
+        let VehicleSpec::RollPlane(vp) = Scenario::table_4_4().vehicle else {
             unreachable!()
         };
-        let p = VehicleUnitParams {
+        VehicleUnitParams {
             vehicle: vp,
             speed: 20.0,
-            wheel_radius: 0.46,
-            dt: 0.0,
-            static_wheel_z: [-1e-3, -1.1e-3],
-        };
+            wheel_radius: 0.475,
+            dt: dt(&vp),
+            static_wheel_z,
+        }
+    }
+
+    #[test]
+    fn state_vector_round_trip_continues_identically() {
+        let p = table_4_4_unit(|_| 0.0, [-1e-3, -1.1e-3]);
         let mut a = VehicleUnit::new(&p).unwrap();
         a.set_forces([150e3, 90e3]).unwrap();
         a.advance(3.3e-3, 0.0).unwrap();
@@ -426,18 +434,8 @@ mod tests {
         // communication steps cycling through sizes that force a change of the step
         // at almost every call. The wheels rest on linear springs fed back by the
         // master (a stand-in track) and get a 10 ms push of half the static load.
-        let s = Scenario::table_4_4();
-        let VehicleSpec::RollPlane(vp) = s.vehicle else {
-            unreachable!()
-        };
-        let p = VehicleUnitParams {
-            vehicle: vp,
-            speed: 20.0,
-            wheel_radius: 0.475,
-            dt: 0.5 * vp.critical_time_step(),
-            static_wheel_z: [-1.4e-3, -1.4e-3],
-        };
-        let w = vp.static_wheel_load();
+        let p = table_4_4_unit(|vp| 0.5 * vp.critical_time_step(), [-1.4e-3, -1.4e-3]);
+        let w = p.vehicle.static_wheel_load();
         let forces = |u: &VehicleUnit, t: f64| {
             let (z, k) = (u.wheel_z(), 2e7);
             let push = if t < 0.01 { 0.5 * w } else { 0.0 };
