@@ -3,6 +3,9 @@
 //!   GUID derived from its content;
 //! - `$OUT_DIR/variables.rs`, the Rust table of the same variables (value references,
 //!   types, causalities, ranges, start values) that the FMI layer reads and writes;
+//! - `$OUT_DIR/VARIABLES.md`, the variables' documentation (`docs/VARIABLES.md` is this
+//!   file, committed: a unit test fails when it is stale, and
+//!   `cargo run --release --bin build_fmus -- fmu docs/VARIABLES.md` rewrites it);
 //! - `$OUT_DIR/wheelflat_fmi2.h`, the C header of the exported FMI functions (cbindgen).
 
 use quick_xml::Reader;
@@ -173,6 +176,89 @@ fn main() {
     }
     writeln!(rust, "}}\n").unwrap();
 
+    // ---- enumerations: item values by type, from TypeDefinitions
+    let mut enums: BTreeMap<String, Vec<(String, i64, String)>> = BTreeMap::new();
+    {
+        let mut r = Reader::from_str(&raw_sections["TypeDefinitions"]);
+        let mut current = String::new();
+        loop {
+            match r.read_event().expect("well-formed TypeDefinitions") {
+                Event::Eof => break,
+                Event::Start(e) if e.name().as_ref() == "SimpleType" => {
+                    current = attrs(&e)["name"].clone();
+                }
+                Event::Empty(e) if e.name().as_ref() == "Item" => {
+                    let a = attrs(&e);
+                    let value = a["value"].parse().expect("integer item value");
+                    enums.entry(current.clone()).or_default().push((
+                        a["name"].clone(),
+                        value,
+                        a.get("description").cloned().unwrap_or_default(),
+                    ));
+                }
+                _ => {}
+            }
+        }
+    }
+    writeln!(
+        rust,
+        "/// Values of the enumerations' items (as `f64`, the FMI layer's value type), one\n\
+         /// module per enumeration type (`ContactModel` -> `contact_model`).\npub mod enums {{"
+    )
+    .unwrap();
+    for (ty, items) in &enums {
+        let mut snake = String::new();
+        for (k, ch) in ty.chars().enumerate() {
+            if ch.is_uppercase() && k > 0 {
+                snake.push('_');
+            }
+            snake.push(ch.to_ascii_lowercase());
+        }
+        writeln!(rust, "    /// `{ty}`\n    pub mod {snake} {{").unwrap();
+        for (name, value, desc) in items {
+            writeln!(
+                rust,
+                "        /// {desc}\n        pub const {}: f64 = {value}.0;",
+                const_name(name)
+            )
+            .unwrap();
+        }
+        writeln!(rust, "    }}").unwrap();
+    }
+    writeln!(rust, "}}\n").unwrap();
+
+    // ---- the flats' value references, [side][k][length, depth, angle, shape]
+    let per_wheel = (1..)
+        .take_while(|k| names_seen.contains_key(&format!("flat.left[{k}].length")))
+        .count();
+    writeln!(
+        rust,
+        "/// Value references of the flats `[side][k]`: length, depth, angle, shape.\n\
+         pub const FLAT_VRS: [[[u32; 4]; {per_wheel}]; 2] = ["
+    )
+    .unwrap();
+    for side in ["left", "right"] {
+        write!(rust, "    [").unwrap();
+        for k in 1..=per_wheel {
+            let r: Vec<String> = ["length", "depth", "angle", "shape"]
+                .iter()
+                .map(|f| {
+                    let n = format!("flat.{side}[{k}].{f}");
+                    names_seen
+                        .get(&n)
+                        .unwrap_or_else(|| panic!("{n} missing from the table"))
+                        .to_string()
+                })
+                .collect();
+            write!(rust, "[{}], ", r.join(", ")).unwrap();
+        }
+        writeln!(rust, "],").unwrap();
+    }
+    writeln!(rust, "];\n").unwrap();
+
+    // Per variable and FMU: the resolved attributes (for docs/VARIABLES.md).
+    let mut resolved: Vec<BTreeMap<String, Attrs>> = vec![BTreeMap::new(); vars.len()];
+
     for fmu in &fmus {
         let id = &fmu["modelIdentifier"];
         let mut fv: Vec<FmuVar> = Vec::new();
@@ -211,6 +297,7 @@ fn main() {
             } else {
                 a.insert("start".into(), String::new());
             }
+            resolved[i].insert(id.clone(), a.clone());
             fv.push(FmuVar { vr: i, a });
         }
         // 1-based indices of the FMU's ModelVariables.
@@ -392,7 +479,17 @@ fn main() {
                 t => panic!("type {t}"),
             };
             let (lo, hi) = if v.ty() == "Enumeration" {
-                ("1.0".to_string(), "2.0".to_string())
+                let ty = v
+                    .get("declaredType")
+                    .expect("Enumeration with declaredType");
+                let values: Vec<i64> = enums[ty].iter().map(|x| x.1).collect();
+                let (lo, hi) = (values.iter().min().unwrap(), values.iter().max().unwrap());
+                assert_eq!(
+                    (hi - lo + 1) as usize,
+                    values.len(),
+                    "{ty}: item values must be consecutive"
+                );
+                (format!("{lo}.0"), format!("{hi}.0"))
             } else {
                 (
                     num(v, "min", "f64::NEG_INFINITY"),
@@ -418,7 +515,18 @@ fn main() {
         }
         writeln!(rust, "    ],\n}};\n").unwrap();
     }
+    writeln!(
+        rust,
+        "/// docs/VARIABLES.md as the table generates it.\n\
+         pub const VARIABLES_MD: &str = include_str!(concat!(env!(\"OUT_DIR\"), \"/VARIABLES.md\"));"
+    )
+    .unwrap();
     fs::write(out.join("variables.rs"), rust).unwrap();
+    fs::write(
+        out.join("VARIABLES.md"),
+        variables_md(&vars, &fmus, &resolved, &enums),
+    )
+    .unwrap();
 
     // ---- C header of the exported functions
     let config = cbindgen::Config {
@@ -466,4 +574,86 @@ fn main() {
         .generate()
         .expect("cbindgen: C header of src/fmu/ffi.rs")
         .write_to_file(out.join("wheelflat_fmi2.h"));
+}
+
+/// docs/VARIABLES.md: one row per variable, its causality in each FMU, type, unit,
+/// start value, range and description.
+fn variables_md(
+    vars: &[TableVar],
+    fmus: &[Attrs],
+    resolved: &[BTreeMap<String, Attrs>],
+    enums: &BTreeMap<String, Vec<(String, i64, String)>>,
+) -> String {
+    let ids: Vec<&str> = fmus.iter().map(|f| f["modelIdentifier"].as_str()).collect();
+    let mut md = String::from(
+        "# FMU variables\n\n\
+         Generated by `build.rs` from `modelDescription/variables.xml`, the one table behind the\n\
+         three model descriptions and the Rust variable table; do not edit: after a change of the\n\
+         table, `cargo run --release --bin build_fmus -- fmu docs/VARIABLES.md` rewrites this\n\
+         file, and a unit test fails while it is stale.\n\n\
+         Columns: T = TrackContact, V = RollPlaneVehicle, C = CoupledSystem, with the variable's\n\
+         causality in each (par = parameter, calc = calculated parameter, in = input, out =\n\
+         output). Units are SI; the display unit is what tools may show. The range is what\n\
+         `fmi2SetReal`/`fmi2SetInteger` accept (the physical ranges of `src/limits.rs`); the\n\
+         engine checks the rest at `fmi2ExitInitializationMode`.\n\n\
+         | name | T | V | C | type | unit (display) | start | range | description |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    let order = ["TrackContact", "RollPlaneVehicle", "CoupledSystem"];
+    assert!(order.iter().all(|o| ids.contains(o)), "FMUs of the table");
+    for (i, v) in vars.iter().enumerate() {
+        let per = &resolved[i];
+        let cols: Vec<&str> = order
+            .iter()
+            .map(|id| match per.get(*id).map(|a| a["causality"].as_str()) {
+                Some("parameter") => "par",
+                Some("calculatedParameter") => "calc",
+                Some("input") => "in",
+                Some("output") => "out",
+                _ => "",
+            })
+            .collect();
+        // The first FMU (in column order) that defines a value gives it.
+        let first = |k: &str| {
+            order
+                .iter()
+                .filter_map(|id| per.get(*id))
+                .find_map(|a| a.get(k).filter(|x| !x.is_empty()).cloned())
+                .unwrap_or_default()
+        };
+        let ty = v
+            .attrs
+            .get("declaredType")
+            .unwrap_or(&v.attrs["type"])
+            .clone();
+        let unit = match (first("unit"), first("displayUnit")) {
+            (u, d) if d.is_empty() => u,
+            (u, d) => format!("{u} ({d})"),
+        };
+        let range = match enums.get(&ty) {
+            Some(items) => items
+                .iter()
+                .map(|(n, val, _)| format!("{val} {n}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            None => match (first("min"), first("max")) {
+                (lo, hi) if lo.is_empty() && hi.is_empty() => String::new(),
+                (lo, hi) if hi.is_empty() => format!(">= {lo}"),
+                (lo, hi) if lo.is_empty() => format!("<= {hi}"),
+                (lo, hi) => format!("{lo} to {hi}"),
+            },
+        };
+        writeln!(
+            md,
+            "| `{}` | {} | {} | {} | {ty} | {unit} | {} | {range} | {} |",
+            v.attrs["name"],
+            cols[0],
+            cols[1],
+            cols[2],
+            first("start"),
+            v.attrs.get("description").cloned().unwrap_or_default()
+        )
+        .unwrap();
+    }
+    md
 }

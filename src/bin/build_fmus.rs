@@ -4,11 +4,13 @@
 //! functions to `fmu/include/wheelflat_fmi2.h`.
 //!
 //! Run after `cargo build --release` (the shared library must sit next to this
-//! executable): `cargo build --release && cargo run --release --bin build_fmus [OUT_DIR]`.
+//! executable): `cargo build --release && cargo run --release --bin build_fmus [OUT_DIR
+//! [VARIABLES.md]]`; the second argument writes the variables' documentation generated
+//! from the table there (`docs/VARIABLES.md`).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use wheelflat::fmu::vars::{C_HEADER, FMUS};
+use wheelflat::fmu::vars::{C_HEADER, FMUS, VARIABLES_MD};
 use zip::write::SimpleFileOptions;
 
 #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
@@ -43,6 +45,11 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             lib.display()
         )
     })?;
+    // A second argument: where to write the variables' documentation.
+    if let Some(doc) = std::env::args().nth(2) {
+        std::fs::write(&doc, VARIABLES_MD)?;
+        println!("{doc} (from the variable table)");
+    }
     std::fs::create_dir_all(out.join("include"))?;
     std::fs::write(out.join("include/wheelflat_fmi2.h"), C_HEADER)?;
     for t in FMUS {

@@ -19,7 +19,7 @@ use crate::profile::{FlatShape, FlatSpec};
 use crate::solver::{Sample, Simulation, VehicleState};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
-use vars::{Causality, FmuTable, N_VR, VarSpec, VarType, vr};
+use vars::{Causality, FLAT_VRS, FmuTable, N_VR, VarSpec, VarType, enums, vr};
 
 /// `fmi2Status`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -364,62 +364,6 @@ impl std::fmt::Debug for Instance {
 /// that the end's reflections raise the forces (the default start position, 1.37 m, is
 /// two spans from the other end).
 pub const END_ZONE_SPANS: f64 = 2.0;
-
-/// Value references of the flats `[side][k]`: length, depth, angle, shape.
-const FLAT_VRS: [[[u32; 4]; 4]; 2] = [
-    [
-        [
-            vr::FLAT_LEFT_1_LENGTH,
-            vr::FLAT_LEFT_1_DEPTH,
-            vr::FLAT_LEFT_1_ANGLE,
-            vr::FLAT_LEFT_1_SHAPE,
-        ],
-        [
-            vr::FLAT_LEFT_2_LENGTH,
-            vr::FLAT_LEFT_2_DEPTH,
-            vr::FLAT_LEFT_2_ANGLE,
-            vr::FLAT_LEFT_2_SHAPE,
-        ],
-        [
-            vr::FLAT_LEFT_3_LENGTH,
-            vr::FLAT_LEFT_3_DEPTH,
-            vr::FLAT_LEFT_3_ANGLE,
-            vr::FLAT_LEFT_3_SHAPE,
-        ],
-        [
-            vr::FLAT_LEFT_4_LENGTH,
-            vr::FLAT_LEFT_4_DEPTH,
-            vr::FLAT_LEFT_4_ANGLE,
-            vr::FLAT_LEFT_4_SHAPE,
-        ],
-    ],
-    [
-        [
-            vr::FLAT_RIGHT_1_LENGTH,
-            vr::FLAT_RIGHT_1_DEPTH,
-            vr::FLAT_RIGHT_1_ANGLE,
-            vr::FLAT_RIGHT_1_SHAPE,
-        ],
-        [
-            vr::FLAT_RIGHT_2_LENGTH,
-            vr::FLAT_RIGHT_2_DEPTH,
-            vr::FLAT_RIGHT_2_ANGLE,
-            vr::FLAT_RIGHT_2_SHAPE,
-        ],
-        [
-            vr::FLAT_RIGHT_3_LENGTH,
-            vr::FLAT_RIGHT_3_DEPTH,
-            vr::FLAT_RIGHT_3_ANGLE,
-            vr::FLAT_RIGHT_3_SHAPE,
-        ],
-        [
-            vr::FLAT_RIGHT_4_LENGTH,
-            vr::FLAT_RIGHT_4_DEPTH,
-            vr::FLAT_RIGHT_4_ANGLE,
-            vr::FLAT_RIGHT_4_SHAPE,
-        ],
-    ],
-];
 
 impl Instance {
     /// A new instance of `kind` with start values, logging through `logger`.
@@ -780,7 +724,7 @@ impl Instance {
                         length: self.v(f[0]),
                         depth: if depth == 0.0 { None } else { Some(depth) },
                         angle: self.v(f[2]),
-                        shape: if self.v(f[3]) == 2.0 {
+                        shape: if self.v(f[3]) == enums::flat_shape::CHORD {
                             FlatShape::Chord
                         } else {
                             FlatShape::Haversine
@@ -801,7 +745,8 @@ impl Instance {
             vehicle,
             wheel_radius: self.v(vr::WHEEL_RADIUS),
             flats,
-            contact_model: if self.v(vr::CONTACT_MODEL) == 2.0 {
+            // The table's range holds the enumeration to its items (checked at set).
+            contact_model: if self.v(vr::CONTACT_MODEL) == enums::contact_model::HERTZ {
                 ContactModel::Hertz
             } else {
                 ContactModel::Adaptive
@@ -1738,15 +1683,16 @@ mod tests {
     }
 
     #[test]
-    fn every_variable_is_documented() {
-        let doc = include_str!("../../docs/VARIABLES.md");
+    fn docs_variables_md_is_the_generated_file() {
+        // build.rs generates it from the table; a stale copy fails here.
+        assert!(
+            include_str!("../../docs/VARIABLES.md") == vars::VARIABLES_MD,
+            "docs/VARIABLES.md is stale: run `cargo build --release && cargo run --release \
+             --bin build_fmus -- fmu docs/VARIABLES.md`"
+        );
         for t in vars::FMUS {
             for v in t.vars {
-                assert!(
-                    doc.contains(&format!("| `{}` |", v.name)),
-                    "{} undocumented",
-                    v.name
-                );
+                assert!(vars::VARIABLES_MD.contains(&format!("| `{}` |", v.name)));
             }
         }
     }
