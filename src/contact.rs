@@ -12,10 +12,8 @@
 //! asymmetric and split patches are all exact to quadrature accuracy.
 
 use crate::error::{Result, out_of_range, positive};
-use crate::profile::{
-    LANES, MAX_FLATS, SMALL_ANGLE, WheelProfile, cos_poly, cos_small, wrap_angle,
-};
-use crate::track::{SimdLevel, inlined};
+use crate::numerics::{LANES, SMALL_ANGLE, SimdLevel, cos_poly, cos_small, inlined, wrap_angle};
+use crate::profile::{MAX_FLATS, WheelProfile};
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.

@@ -18,6 +18,7 @@ pub mod cosim;
 pub mod error;
 pub mod fmu;
 pub mod limits;
+pub mod numerics;
 pub mod params;
 pub mod profile;
 pub mod solver;
