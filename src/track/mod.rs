@@ -1,0 +1,41 @@
+//! Track: two Timoshenko rails (3.4, 3.5, 3.10) on discrete sleepers with bounce and
+//! roll (3.6-3.9, 3.16), rail pads and ballast, solved by explicit central
+//! differences in time and space (3.11, 3.12, 3.18).
+//!
+//! Grid: `dx = a / n`, nodes `k = 0..=K` with `K = N n` on each rail, sleepers at
+//! every n-th node, both ends included (N spans = N + 1 sleepers). Rail ends are
+//! fixed (`Z = theta = 0`). A point force `F` enters its node's equation as `F / dx`;
+//! a moving wheel load is shared between the two nodes around it by (3.22) and the
+//! rail displacement under the wheel is interpolated by (3.23).
+//!
+//! Sign conventions: displacements up, pad force (3.9)
+//! `F = -K_p (Z_rail - Z_seat) - C_p (dZ_rail/dt - dZ_seat/dt)` acts up on the rail and
+//! down on the sleeper; pad damper velocities are backward differences so the rail
+//! update stays explicit; ballast damping uses central differences (3.18).
+//!
+//! The rail update is written as one stencil loop over both rails stored end to end
+//! (the fixed end nodes separate them), with no allocation and no bounds checks, so
+//! the compiler vectorises it.
+
+mod kernels;
+mod params;
+mod probe;
+mod state;
+mod static_solve;
+mod stepper;
+mod storage;
+#[cfg(test)]
+mod tests;
+
+pub use crate::numerics::SimdLevel;
+pub use params::{RailEnds, RailSection, TrackParams};
+pub use probe::perturbation_growth;
+pub use stepper::{PointLoad, Track};
+
+// What the files of the track share (each begins with `use super::*`).
+use crate::error::{Error, Result, out_of_range, positive};
+use crate::limits::{MAX_NODES_PER_SPAN, MAX_RAIL_SEGMENTS, check};
+use crate::numerics::{LANES, inlined};
+use kernels::*;
+use nalgebra::{DMatrix, DVector, Matrix4, SymmetricEigen};
+use storage::*;

@@ -1,0 +1,263 @@
+//! The stiffness of the track, its direct static solve (banded, unknowns ordered along
+//! the track) and the discrete energy.
+
+use super::*;
+
+impl Track {
+    /// Number of unknowns of the static problem.
+    pub(super) fn static_size(&self) -> usize {
+        4 * self.nk + 2 * self.ns
+    }
+
+    /// Symmetric stiffness matrix `K` of the discrete equations (rows scaled by dx so
+    /// that `M = diag(m dx, m r^2 dx, m_s, J_s)`), unknowns ordered
+    /// `[Z (both rails), theta (both rails), Z_s, phi_s]`. Fixed degrees of freedom have
+    /// identity rows and columns. Dense: for tests and energy checks on short tracks
+    /// (the static solve assembles its band directly, see [`Track::set_static`]).
+    pub fn stiffness_matrix(&self) -> DMatrix<f64> {
+        let n = self.static_size();
+        let mut k = DMatrix::<f64>::zeros(n, n);
+        self.stiffness_entries(|i, j, v| k[(i, j)] += v);
+        k
+    }
+
+    /// Every contribution `v` to entry `(i, j)` of [`Track::stiffness_matrix`], in one
+    /// fixed order (so any assembly sums each entry's contributions alike).
+    pub(super) fn stiffness_entries(&self, mut add: impl FnMut(usize, usize, f64)) {
+        let p = &self.params;
+        let r = &p.rail;
+        let dx = p.dx();
+        let nk = self.nk;
+        let ns = self.ns;
+        let (iz, it, izs, iph) = (0, 2 * nk, 4 * nk, 4 * nk + ns);
+        let pinned = p.ends == RailEnds::Pinned;
+        for rail in 0..2 {
+            for node in 0..nk {
+                let g = rail * nk + node;
+                let end = node == 0 || node == nk - 1;
+                // Deflection row.
+                if end {
+                    add(iz + g, iz + g, 1.0);
+                } else {
+                    add(iz + g, iz + g, 2.0 * r.kag / dx);
+                    for nb in [g - 1, g + 1] {
+                        let nb_end = nb % nk == 0 || nb % nk == nk - 1;
+                        if !nb_end {
+                            add(iz + g, iz + nb, -(r.kag / dx));
+                        }
+                        let sgn = if nb > g { 0.5 } else { -0.5 };
+                        if !nb_end || pinned {
+                            add(iz + g, it + nb, sgn * r.kag);
+                        }
+                    }
+                }
+                // Rotation row.
+                if end && !pinned {
+                    add(it + g, it + g, 1.0);
+                } else if end {
+                    let inner = if node == 0 { g + 1 } else { g - 1 };
+                    let sgn = if node == 0 { -0.5 } else { 0.5 };
+                    add(it + g, it + g, r.ei / dx + 0.5 * r.kag * dx);
+                    add(it + g, it + inner, -(r.ei / dx));
+                    add(it + g, iz + inner, sgn * r.kag);
+                } else {
+                    add(it + g, it + g, 2.0 * r.ei / dx + r.kag * dx);
+                    for nb in [g - 1, g + 1] {
+                        let nb_end = nb % nk == 0 || nb % nk == nk - 1;
+                        if !nb_end || pinned {
+                            add(it + g, it + nb, -(r.ei / dx));
+                        }
+                        let sgn = if nb > g { -0.5 } else { 0.5 };
+                        if !nb_end {
+                            add(it + g, iz + nb, sgn * r.kag);
+                        }
+                    }
+                }
+            }
+        }
+        let ls = 0.5 * p.rail_seat_distance;
+        for i in 0..ns {
+            let node = i * p.nodes_per_span;
+            for (rail, arm) in [(0usize, -ls), (1usize, ls)] {
+                let g = rail * nk + node;
+                let rail_fixed = node == 0 || node == nk - 1;
+                // pad energy 1/2 K_p (Z - Z_s - arm phi)^2
+                let idx = [iz + g, izs + i, iph + i];
+                let v = [1.0, -1.0, -arm];
+                for a in 0..3 {
+                    for b in 0..3 {
+                        if rail_fixed && (a == 0 || b == 0) {
+                            continue;
+                        }
+                        add(idx[a], idx[b], p.pad_stiffness * v[a] * v[b]);
+                    }
+                }
+            }
+            add(izs + i, izs + i, 2.0 * p.ballast_stiffness);
+            add(iph + i, iph + i, 2.0 * ls * ls * p.ballast_stiffness);
+        }
+    }
+
+    /// Puts the track in static equilibrium under `loads` (the same discrete equations
+    /// with zero accelerations and velocities), solved directly.
+    pub fn set_static(&mut self, loads: &[PointLoad]) -> Result<()> {
+        let n = self.static_size();
+        let (nk, ns, sp) = (self.nk, self.ns, self.sp);
+        let mut f = DVector::<f64>::zeros(n);
+        for l in loads {
+            let (kk, w) = self.locate(l.position);
+            let base = l.rail.min(1) * nk;
+            for (node, share) in [(kk, 1.0 - w), (kk + 1, w)] {
+                if node != 0 && node != nk - 1 {
+                    f[base + node] -= share * l.force;
+                }
+            }
+        }
+        let x = self.solve_static_banded(f.as_slice()).ok_or_else(|| {
+            out_of_range(
+                "track.pad.stiffness",
+                self.params.pad_stiffness,
+                format!(
+                    "a track whose pads and ballast hold the rails (static solve singular \
+                         with track.pad.stiffness = {} N/m and track.ballast.stiffness = {} \
+                         N/m: give both > 0)",
+                    crate::error::num(self.params.pad_stiffness),
+                    crate::error::num(self.params.ballast_stiffness)
+                ),
+            )
+        })?;
+        let xs = x.as_slice();
+        Self::from_nodes(&self.slot, sp, &xs[..2 * nk], &mut self.z);
+        Self::from_nodes(&self.slot, sp, &xs[2 * nk..4 * nk], &mut self.th);
+        self.zs[..ns].copy_from_slice(&xs[4 * nk..4 * nk + ns]);
+        self.ph[..ns].copy_from_slice(&xs[4 * nk + ns..]);
+        self.z_prev.copy_from_slice(&self.z);
+        self.th_prev.copy_from_slice(&self.th);
+        self.zs_prev.copy_from_slice(&self.zs);
+        self.ph_prev.copy_from_slice(&self.ph);
+        let ls = 0.5 * self.params.rail_seat_distance;
+        for i in 0..ns {
+            // Block 0 holds the rail nodes above the sleepers.
+            let s = block_start(0, self.params.nodes_per_span, sp) + i;
+            let (zl, zr) = (self.z[s], self.z[s + sp]);
+            self.pad[i] = -self.params.pad_stiffness * (zl - self.zs[i] + ls * self.ph[i]);
+            self.pad[sp + i] = -self.params.pad_stiffness * (zr - self.zs[i] - ls * self.ph[i]);
+        }
+        Ok(())
+    }
+
+    /// Unknowns of [`Track::stiffness_matrix`] in order along the track: at each node
+    /// `Z` and `theta` of the left rail, then of the right rail, then the sleeper's
+    /// bounce and roll where a sleeper sits. Couplings then stay within a few places
+    /// of the diagonal.
+    pub(super) fn static_order_along_track(&self) -> Vec<usize> {
+        let (nk, ns, n) = (self.nk, self.ns, self.params.nodes_per_span);
+        let mut order = Vec::with_capacity(self.static_size());
+        for k in 0..nk {
+            order.extend([k, 2 * nk + k, nk + k, 3 * nk + k]);
+            if k % n == 0 {
+                order.extend([4 * nk + k / n, 4 * nk + ns + k / n]);
+            }
+        }
+        order
+    }
+
+    /// Solves `K x = f` for the symmetric positive definite stiffness matrix by
+    /// Gaussian elimination on its band, unknowns taken in order along the track, the
+    /// band assembled directly from [`Track::stiffness_entries`]: `O(N b)` memory and
+    /// `O(N b^2)` time with half-bandwidth `b` of about 10, where the dense matrix
+    /// would take `O(N^2)` and `O(N^3)`. `None` when a pivot is not positive: `K` is
+    /// singular.
+    pub(super) fn solve_static_banded(&self, f: &[f64]) -> Option<Vec<f64>> {
+        let order = self.static_order_along_track();
+        let n = order.len();
+        // Position along the track of each unknown.
+        let mut pos = vec![0; n];
+        for (i, &g) in order.iter().enumerate() {
+            pos[g] = i;
+        }
+        let mut bw = 0;
+        self.stiffness_entries(|i, j, v| {
+            if v != 0.0 {
+                bw = bw.max(pos[i].abs_diff(pos[j]));
+            }
+        });
+        let w = 2 * bw + 1;
+        let mut a = vec![0.0; n * w];
+        let at = |i: usize, j: usize| i * w + j + bw - i;
+        self.stiffness_entries(|i, j, v| {
+            if v != 0.0 {
+                a[at(pos[i], pos[j])] += v;
+            }
+        });
+        let mut b: Vec<f64> = order.iter().map(|&g| f[g]).collect();
+        let scale = (0..n).map(|i| a[at(i, i)].abs()).fold(0.0, f64::max);
+        for c in 0..n {
+            let pivot = a[at(c, c)];
+            if pivot.is_nan() || pivot <= 1e-14 * scale {
+                return None;
+            }
+            let end = (c + bw + 1).min(n);
+            for i in c + 1..end {
+                let l = a[at(i, c)] / pivot;
+                if l == 0.0 {
+                    continue;
+                }
+                for j in c + 1..end {
+                    a[at(i, j)] -= l * a[at(c, j)];
+                }
+                b[i] -= l * b[c];
+            }
+        }
+        let mut y = vec![0.0; n];
+        for i in (0..n).rev() {
+            let mut s = b[i];
+            for j in i + 1..(i + bw + 1).min(n) {
+                s -= a[at(i, j)] * y[j];
+            }
+            y[i] = s / a[at(i, i)];
+        }
+        let mut x = vec![0.0; n];
+        for (i, &g) in order.iter().enumerate() {
+            x[g] = y[i];
+        }
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+
+    /// Discrete energy of the undamped scheme (J): `1/2 v^T M v + 1/2 x_(j-1)^T K x_j`
+    /// with `v = (x_j - x_(j-1)) / dt`; exactly conserved by the central-difference
+    /// recurrence when all damping is zero and no load acts.
+    pub fn discrete_energy(&self, k: &DMatrix<f64>) -> f64 {
+        let p = &self.params;
+        let dx = p.dx();
+        let nk = self.nk;
+        let ns = self.ns;
+        let n = self.static_size();
+        let mut x = DVector::<f64>::zeros(n);
+        let mut xp = DVector::<f64>::zeros(n);
+        let mut mass = DVector::<f64>::zeros(n);
+        let (z, zp) = (self.to_nodes(&self.z), self.to_nodes(&self.z_prev));
+        let (th, thp) = (self.to_nodes(&self.th), self.to_nodes(&self.th_prev));
+        for i in 0..2 * nk {
+            let end = i % nk == 0 || i % nk == nk - 1;
+            x[i] = z[i];
+            xp[i] = zp[i];
+            mass[i] = p.rail.mass * dx;
+            x[2 * nk + i] = th[i];
+            xp[2 * nk + i] = thp[i];
+            mass[2 * nk + i] = p.rail.rotary_inertia * if end { 0.5 * dx } else { dx };
+        }
+        for i in 0..ns {
+            x[4 * nk + i] = self.zs[i];
+            xp[4 * nk + i] = self.zs_prev[i];
+            mass[4 * nk + i] = p.sleeper_mass;
+            x[4 * nk + ns + i] = self.ph[i];
+            xp[4 * nk + ns + i] = self.ph_prev[i];
+            mass[4 * nk + ns + i] = p.sleeper_inertia;
+        }
+        let v = (&x - &xp) / self.dt;
+        let kin = 0.5 * v.component_mul(&v).dot(&mass);
+        let pot = 0.5 * xp.dot(&(k * &x));
+        kin + pot
+    }
+}
