@@ -301,6 +301,26 @@ struct Published {
     kw_used: f64,
 }
 
+impl Published {
+    /// The values in the order FMU states store them.
+    fn to_array(self) -> [f64; 7] {
+        let [l, r] = self.static_load;
+        let [zl, zr] = self.static_wheel_z;
+        [l, r, zl, zr, self.step, self.critical_step, self.kw_used]
+    }
+
+    /// The inverse of [`Published::to_array`].
+    fn from_array([l, r, zl, zr, step, critical_step, kw_used]: [f64; 7]) -> Self {
+        Published {
+            static_load: [l, r],
+            static_wheel_z: [zl, zr],
+            step,
+            critical_step,
+            kw_used,
+        }
+    }
+}
+
 /// Everything an FMU state holds: enough to continue bit-identically.
 #[derive(Debug, Clone)]
 pub struct Snapshot {
@@ -539,29 +559,6 @@ impl Instance {
                 names.join(", ")
             ),
         )
-    }
-
-    /// The state check of `call` by its C name, for callers that still pass their own
-    /// list: `allowed` must be the table's entry (checked in debug builds); a refusal
-    /// comes from [`Instance::check`], with the table's message. New code calls
-    /// [`Instance::check`] with the [`Call`].
-    #[inline]
-    fn require(&mut self, call: &str, allowed: &[Phase]) -> FmiResult {
-        debug_assert!(
-            Call::from_name(call)
-                .is_some_and(|c| matches!(c.allowed(), Allowed::In(p) if p == allowed)),
-            "{call}: the phases {allowed:?} are not the table's"
-        );
-        if allowed.contains(&self.phase()) {
-            return Ok(());
-        }
-        match Call::from_name(call) {
-            Some(c) => self.refuse_call(c),
-            None => self.refuse(
-                Status::Error,
-                format!("{call}: not an FMI 2.0 co-simulation function"),
-            ),
-        }
     }
 
     /// `fmi2SetupExperiment`.
@@ -899,8 +896,9 @@ impl Instance {
     }
 
     /// Reads variables into `out` (Real or Integer/Enumeration by `real`).
-    fn get(&mut self, call: &str, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
-        self.require(call, READ)?;
+    fn get(&mut self, call: Call, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
+        self.check(call)?;
+        let call = call.name();
         let mut needs_model = false;
         for &r in vrs {
             let s = self.spec(call, r)?;
@@ -1051,15 +1049,9 @@ impl Instance {
 
     /// Writes variables (Real or Integer/Enumeration by `real`): every value is checked
     /// before any is stored, so a refused call changes nothing.
-    fn set(&mut self, call: &str, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
-        self.require(
-            call,
-            &[
-                Phase::Instantiated,
-                Phase::Initialization,
-                Phase::StepComplete,
-            ],
-        )?;
+    fn set(&mut self, call: Call, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
+        self.check(call)?;
+        let call = call.name();
         for (&r, &x) in vrs.iter().zip(vals) {
             let s = self.spec(call, r)?;
             self.check_type(call, s, real)?;
@@ -1124,13 +1116,13 @@ impl Instance {
 
     /// `fmi2GetReal`.
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
-        self.get("fmi2GetReal", vrs, out, true)
+        self.get(Call::GetReal, vrs, out, true)
     }
 
     /// `fmi2GetInteger` (integers and enumerations).
     pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
         let mut tmp = vec![0.0; vrs.len()];
-        self.get("fmi2GetInteger", vrs, &mut tmp, false)?;
+        self.get(Call::GetInteger, vrs, &mut tmp, false)?;
         for (o, t) in out.iter_mut().zip(tmp) {
             *o = t as i32;
         }
@@ -1139,13 +1131,13 @@ impl Instance {
 
     /// `fmi2SetReal`.
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> FmiResult {
-        self.set("fmi2SetReal", vrs, vals, true)
+        self.set(Call::SetReal, vrs, vals, true)
     }
 
     /// `fmi2SetInteger` (integers and enumerations).
     pub fn set_integer(&mut self, vrs: &[u32], vals: &[i32]) -> FmiResult {
         let tmp: Vec<f64> = vals.iter().map(|&x| x as f64).collect();
-        self.set("fmi2SetInteger", vrs, &tmp, false)
+        self.set(Call::SetInteger, vrs, &tmp, false)
     }
 
     /// Boolean and String access: these FMUs have no such variables, so any value
@@ -1417,15 +1409,7 @@ impl Instance {
         let failed = s.failed.as_deref().unwrap_or("").as_bytes();
         b.extend_from_slice(&(failed.len() as u64).to_le_bytes());
         b.extend_from_slice(failed);
-        for x in [
-            s.published.static_load[0],
-            s.published.static_load[1],
-            s.published.static_wheel_z[0],
-            s.published.static_wheel_z[1],
-            s.published.step,
-            s.published.critical_step,
-            s.published.kw_used,
-        ] {
+        for x in s.published.to_array() {
             b.extend_from_slice(&x.to_le_bytes());
         }
         b.extend_from_slice(&(s.values.len() as u64).to_le_bytes());
@@ -1547,15 +1531,7 @@ impl Instance {
             let built = self.build();
             self.values = saved;
             let (mut m, rebuilt) = built.map_err(|e| format!("stored parameters refused: {e}"))?;
-            let again = [
-                rebuilt.static_load[0],
-                rebuilt.static_load[1],
-                rebuilt.static_wheel_z[0],
-                rebuilt.static_wheel_z[1],
-                rebuilt.step,
-                rebuilt.critical_step,
-                rebuilt.kw_used,
-            ];
+            let again = rebuilt.to_array();
             if let Some(k) = (0..7).find(|&k| again[k].to_bits() != pubs[k].to_bits()) {
                 return Err(format!(
                     "stored calculated parameter {k} = {} disagrees with the {} the stored \
@@ -1589,13 +1565,7 @@ impl Instance {
             phase,
             values,
             model,
-            published: Published {
-                static_load: [pubs[0], pubs[1]],
-                static_wheel_z: [pubs[2], pubs[3]],
-                step: pubs[4],
-                critical_step: pubs[5],
-                kw_used: pubs[6],
-            },
+            published: Published::from_array(pubs),
             time,
             start_time,
             ended,
