@@ -283,7 +283,7 @@ impl VehicleUnit {
                 "22 values",
             ));
         }
-        let count = |x: f64| (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0;
+        let count = crate::limits::is_count;
         let min_step = MIN_STEP_FRACTION * self.dt_base;
         if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1]) && v[2] >= 0.0 && v[2] < min_step) {
             return Err(out_of_range(

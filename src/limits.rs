@@ -125,6 +125,12 @@ pub const MAX_STATIC_DEFLECTION: f64 = 0.3;
 /// 64 puts a node every 11 mm, finer than any contact patch.
 pub const MAX_NODES_PER_SPAN: usize = 64;
 
+/// `x` is a whole number in `[0, 2^53)`: a step count that an FMU state (stored as
+/// `f64`) may hold.
+pub fn is_count(x: f64) -> bool {
+    (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0
+}
+
 /// A contact force above this many static wheel loads is reached by no physical run.
 pub const FORCE_LIMIT_FACTOR: f64 = 20.0;
 /// The static load the force limit is taken from is at least this (N), so an unloaded

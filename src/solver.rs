@@ -202,8 +202,16 @@ impl Simulation {
         let static_load = match &s.vehicle {
             VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
             VehicleSpec::LumpedWheels(p) => [p.load; 2],
-            VehicleSpec::ConstantLoad(p) => *p,
-            VehicleSpec::External { static_load } => *static_load,
+            VehicleSpec::ConstantLoad(p) => {
+                non_negative("load.left", p[0], "N")?;
+                non_negative("load.right", p[1], "N")?;
+                *p
+            }
+            VehicleSpec::External { static_load } => {
+                non_negative("static_load.left", static_load[0], "N")?;
+                non_negative("static_load.right", static_load[1], "N")?;
+                *static_load
+            }
         };
         let law = match s.contact_model {
             ContactModel::Adaptive => {
@@ -291,33 +299,15 @@ impl Simulation {
             }
             TrackSpec::Lumped(p) => TrackState::Lumped(LumpedTrack::new(*p, dt)?),
         };
-        let (vehicle, _) = match &s.vehicle {
-            VehicleSpec::RollPlane(p) => {
-                let v = RollPlaneVehicle::new(*p, dt)?;
-                let w = p.static_wheel_load();
-                (VehicleState::RollPlane(v), [w, w])
-            }
-            VehicleSpec::LumpedWheels(p) => (
-                VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?),
-                [p.load; 2],
-            ),
-            VehicleSpec::ConstantLoad(p) => {
-                non_negative("load.left", p[0], "N")?;
-                non_negative("load.right", p[1], "N")?;
-                (VehicleState::ConstantLoad(*p), *p)
-            }
-            VehicleSpec::External { static_load } => {
-                non_negative("static_load.left", static_load[0], "N")?;
-                non_negative("static_load.right", static_load[1], "N")?;
-                (
-                    VehicleState::External {
-                        wheel_z: [0.0; 2],
-                        rotation: 0.0,
-                        since: 0.0,
-                    },
-                    *static_load,
-                )
-            }
+        let vehicle = match &s.vehicle {
+            VehicleSpec::RollPlane(p) => VehicleState::RollPlane(RollPlaneVehicle::new(*p, dt)?),
+            VehicleSpec::LumpedWheels(p) => VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?),
+            VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
+            VehicleSpec::External { .. } => VehicleState::External {
+                wheel_z: [0.0; 2],
+                rotation: 0.0,
+                since: 0.0,
+            },
         };
         let mut sim = Simulation {
             scenario: s.clone(),
@@ -739,28 +729,69 @@ impl Simulation {
         Ok(())
     }
 
-    /// The error for a wheel or rail displacement under the wheel beyond the bound.
+    /// The error for a wheel or rail displacement under the wheel of the latest sample
+    /// beyond the bound.
     #[cold]
     #[inline(never)]
     fn displacement_diverged(&self) -> Error {
-        let s = &self.latest;
-        let names = [
-            ("wheel.left.z (m)", s.wheel_z[0]),
-            ("wheel.right.z (m)", s.wheel_z[1]),
-            ("rail.left.z under the wheel (m)", s.rail_z[0]),
-            ("rail.right.z under the wheel (m)", s.rail_z[1]),
+        // The caller found one of the four displacements beyond the bound, and they
+        // lead the list; the fallback is never taken.
+        self.sample_beyond_bounds(&self.latest)
+            .unwrap_or_else(|| Error::NonFinite {
+                what: "wheel or rail under the wheel".into(),
+                time: self.latest.time,
+            })
+    }
+
+    /// The first value of sample `s` (or of the force extremes) beyond the health
+    /// bounds, as the error that names it: wheel and rail under the wheel within
+    /// [`DISPLACEMENT_LIMIT`], contact forces and their extremes within the force limit.
+    fn sample_beyond_bounds(&self, s: &Sample) -> Option<Error> {
+        let lim = self.force_limit;
+        let values = [
+            ("wheel.left.z (m)", s.wheel_z[0], DISPLACEMENT_LIMIT),
+            ("wheel.right.z (m)", s.wheel_z[1], DISPLACEMENT_LIMIT),
+            (
+                "rail.left.z under the wheel (m)",
+                s.rail_z[0],
+                DISPLACEMENT_LIMIT,
+            ),
+            (
+                "rail.right.z under the wheel (m)",
+                s.rail_z[1],
+                DISPLACEMENT_LIMIT,
+            ),
+            ("contact.left.force (N)", s.contact[0].force, lim),
+            ("contact.right.force (N)", s.contact[1].force, lim),
+            (
+                "contact.left.max_force (N)",
+                self.max_force[0].max(0.0),
+                lim,
+            ),
+            (
+                "contact.right.max_force (N)",
+                self.max_force[1].max(0.0),
+                lim,
+            ),
+            (
+                "contact.left.min_force (N)",
+                self.min_force[0].min(0.0),
+                lim,
+            ),
+            (
+                "contact.right.min_force (N)",
+                self.min_force[1].min(0.0),
+                lim,
+            ),
         ];
-        let (what, value) = names
-            .into_iter()
-            .find(|(_, x)| !within(*x, DISPLACEMENT_LIMIT))
-            .unwrap_or(names[0]);
-        Error::Diverged {
+        let (what, value, limit) = values.into_iter().find(|(_, x, l)| !within(*x, *l))?;
+        Some(Error::Diverged {
             what: what.into(),
             value,
-            limit: DISPLACEMENT_LIMIT,
+            limit,
             time: s.time,
             cause: self.likely_cause(),
-        }
+        })
     }
 
     /// The error for a contact force beyond [`crate::limits::force_limit`].
@@ -941,7 +972,7 @@ impl Simulation {
                 ));
             }
         }
-        let count = |x: f64| (0.0..9.007_199_254_740_992e15).contains(&x) && x.fract() == 0.0;
+        let count = crate::limits::is_count;
         if v.len() >= 4 && !(v[1].is_finite() && v[1] >= 0.0 && count(v[2]) && count(v[3])) {
             return Err(out_of_range(
                 "state: clock",
@@ -1004,55 +1035,10 @@ impl Simulation {
     /// The sample part of [`Simulation::check_health`]: cheap (the sample is cached and
     /// used by the next step).
     pub fn check_sample(&self) -> Result<()> {
-        let s = self.sample();
-        let lim = self.force_limit;
-        for (what, x, limit) in [
-            ("wheel.left.z (m)", s.wheel_z[0], DISPLACEMENT_LIMIT),
-            ("wheel.right.z (m)", s.wheel_z[1], DISPLACEMENT_LIMIT),
-            (
-                "rail.left.z under the wheel (m)",
-                s.rail_z[0],
-                DISPLACEMENT_LIMIT,
-            ),
-            (
-                "rail.right.z under the wheel (m)",
-                s.rail_z[1],
-                DISPLACEMENT_LIMIT,
-            ),
-            ("contact.left.force (N)", s.contact[0].force, lim),
-            ("contact.right.force (N)", s.contact[1].force, lim),
-            (
-                "contact.left.max_force (N)",
-                self.max_force[0].max(0.0),
-                lim,
-            ),
-            (
-                "contact.right.max_force (N)",
-                self.max_force[1].max(0.0),
-                lim,
-            ),
-            (
-                "contact.left.min_force (N)",
-                self.min_force[0].min(0.0),
-                lim,
-            ),
-            (
-                "contact.right.min_force (N)",
-                self.min_force[1].min(0.0),
-                lim,
-            ),
-        ] {
-            if !within(x, limit) {
-                return Err(Error::Diverged {
-                    what: what.into(),
-                    value: x,
-                    limit,
-                    time: s.time,
-                    cause: self.likely_cause(),
-                });
-            }
+        match self.sample_beyond_bounds(&self.sample()) {
+            Some(e) => Err(e),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Runs until `duration` (s) from now, calling `each` with every sample.
