@@ -9,9 +9,7 @@
 //! [`crate::solver::Simulation`].
 
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{
-    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
-};
+use crate::limits::{MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within};
 use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
 use nalgebra::Vector6;
 
@@ -209,38 +207,11 @@ impl VehicleUnit {
 
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
-        let d = self.vehicle.displacements();
-        let d_prev = self.vehicle.previous_displacements();
-        let wheels = self.vehicle.wheel_z();
-        let bad = d
-            .iter()
-            .chain(d_prev.iter())
-            .enumerate()
-            .map(|(i, x)| (i % 6, x))
-            .map(|(i, &x)| {
-                (
-                    crate::vehicle::BODY_DOFS[i].to_string(),
-                    x,
-                    BODY_DISPLACEMENT_LIMIT,
-                )
-            })
-            .chain([
-                (
-                    "wheel.left.z (m)".to_string(),
-                    wheels[0],
-                    DISPLACEMENT_LIMIT,
-                ),
-                (
-                    "wheel.right.z (m)".to_string(),
-                    wheels[1],
-                    DISPLACEMENT_LIMIT,
-                ),
-            ])
-            .find(|(_, x, lim)| !within(*x, *lim));
+        let bad = self.vehicle.beyond_bounds();
         match bad {
             None => Ok(()),
             Some((what, value, limit)) => Err(Error::Diverged {
-                what,
+                what: what.into(),
                 value,
                 limit,
                 time: self.time(),

@@ -8,8 +8,8 @@
 use crate::contact::{ContactLaw, ContactModel, ContactState, kw_from_hertz};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{
-    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_STATIC_OVERLAP,
-    MAX_STATIC_RAIL_DEFLECTION, MIN_DT_FRACTION, force_limit, within,
+    DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_STATIC_OVERLAP, MAX_STATIC_RAIL_DEFLECTION,
+    MIN_DT_FRACTION, force_limit, within,
 };
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
@@ -693,7 +693,8 @@ impl Simulation {
 
     /// Checks every state of the track and the vehicle against the health bounds of
     /// [`crate::limits`]: rail and sleeper displacements within
-    /// [`DISPLACEMENT_LIMIT`], vehicle bodies within [`BODY_DISPLACEMENT_LIMIT`], all
+    /// [`DISPLACEMENT_LIMIT`], vehicle bodies within
+    /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`], all
     /// finite. Run every [`HEALTH_CHECK_INTERVAL`] steps and after the static solve.
     pub fn check_states(&self) -> Result<()> {
         if let TrackState::Discrete(t) = &self.track {
@@ -708,23 +709,16 @@ impl Simulation {
                 });
             }
         }
-        if let VehicleState::RollPlane(v) = &self.vehicle {
-            let d = v.displacements();
-            if let Some((i, x)) = d
-                .iter()
-                .chain(v.previous_displacements().iter())
-                .enumerate()
-                .map(|(i, x)| (i % 6, x))
-                .find(|(_, x)| !within(**x, BODY_DISPLACEMENT_LIMIT))
-            {
-                return Err(Error::Diverged {
-                    what: format!("vehicle {}", crate::vehicle::BODY_DOFS[i]),
-                    value: *x,
-                    limit: BODY_DISPLACEMENT_LIMIT,
-                    time: self.time(),
-                    cause: self.likely_cause(),
-                });
-            }
+        if let VehicleState::RollPlane(v) = &self.vehicle
+            && let Some((what, value, limit)) = v.beyond_bounds()
+        {
+            return Err(Error::Diverged {
+                what: format!("vehicle {what}"),
+                value,
+                limit,
+                time: self.time(),
+                cause: self.likely_cause(),
+            });
         }
         Ok(())
     }

@@ -11,7 +11,9 @@
 //! Roll angles are positive when they raise the right side (MODEL.md).
 
 use crate::error::{Error, Result, non_negative, out_of_range, positive};
-use crate::limits::{MAX_STATIC_DEFLECTION, check};
+use crate::limits::{
+    BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MAX_STATIC_DEFLECTION, check, within,
+};
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 /// Parameters of the roll-plane vehicle (table 4.4 names).
@@ -331,6 +333,22 @@ impl RollPlaneVehicle {
     /// Displacements at t_(j-1) (m, rad).
     pub fn previous_displacements(&self) -> &Vector6<f64> {
         &self.d_prev
+    }
+
+    /// The first displacement (name with unit, value, bound) beyond the health bounds of
+    /// [`crate::limits`]: a body at t_j or t_(j-1) beyond
+    /// [`BODY_DISPLACEMENT_LIMIT`], a wheel centre beyond [`DISPLACEMENT_LIMIT`]; `None`
+    /// when all are within them (and finite).
+    pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
+        let bodies = self.d.iter().chain(self.d_prev.iter()).enumerate();
+        let w = self.wheel_z();
+        bodies
+            .map(|(i, &x)| (BODY_DOFS[i % 6], x, BODY_DISPLACEMENT_LIMIT))
+            .chain([
+                ("wheel.left.z (m)", w[0], DISPLACEMENT_LIMIT),
+                ("wheel.right.z (m)", w[1], DISPLACEMENT_LIMIT),
+            ])
+            .find(|&(_, x, limit)| !within(x, limit))
     }
 
     /// Velocities at t_j by backward difference (m/s, rad/s).
