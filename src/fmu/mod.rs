@@ -1240,7 +1240,8 @@ impl Instance {
                 (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
                     format!(
                         "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
-                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about two seconds)",
+                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
+                         default track)",
                         sim.dt(),
                         sim.rail_nodes(),
                         num(cost)
@@ -1273,6 +1274,12 @@ impl Instance {
             }
             None => Err(Error::Unsupported("stepping before initialisation".into())),
         };
+        // CoupledSystem has no inputs: the sample at the end of the step is final (and
+        // cached for the next step), so a value beyond the bounds there fails this step.
+        let r = r.and_then(|()| match (self.kind, &self.model) {
+            (Kind::CoupledSystem, Some(Model::Sim(sim))) => sim.check_sample(),
+            _ => Ok(()),
+        });
         if let Err(e) = r {
             match e {
                 Error::OffTrack { .. } => {
@@ -1290,15 +1297,6 @@ impl Instance {
             return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
-        // CoupledSystem has no inputs: the sample at the end of the step is final (and
-        // cached for the next step), so a value beyond the bounds there fails this step.
-        if let (Kind::CoupledSystem, Some(Model::Sim(sim))) = (self.kind, &self.model)
-            && let Err(e) = sim.check_sample()
-        {
-            self.failed = Some(e.to_string());
-            self.phase = Phase::Error;
-            return self.engine_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
-        }
         self.warn_near_track_end();
         Ok(())
     }
