@@ -1,0 +1,58 @@
+//! This project's three FMUs over the FMI 2.0 layer: which FMU an instance is
+//! ([`Kind`]), the engine's parameters from its variables, its outputs, and the
+//! [`FmuModel`] that implements [`crate::fmu::fmi2::Model`].
+
+mod outputs;
+mod parameters;
+mod unit;
+
+pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};
+pub use unit::{END_ZONE_SPANS, FmuModel};
+
+use crate::fmu::vars::{self, FmuTable};
+
+/// Which of the three FMUs an instance is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Track and contact, wheels as inputs.
+    TrackContact,
+    /// Roll-plane vehicle, contact forces as inputs.
+    RollPlaneVehicle,
+    /// The whole model.
+    CoupledSystem,
+}
+
+impl Kind {
+    /// The three FMUs.
+    pub const ALL: [Kind; 3] = [
+        Kind::TrackContact,
+        Kind::RollPlaneVehicle,
+        Kind::CoupledSystem,
+    ];
+
+    /// The FMU with this GUID.
+    pub fn from_guid(guid: &str) -> Option<Kind> {
+        Kind::ALL.into_iter().find(|k| k.table().guid == guid)
+    }
+
+    /// Variable table of this FMU.
+    pub fn table(self) -> &'static FmuTable {
+        match self {
+            Kind::TrackContact => &vars::TRACK_CONTACT,
+            Kind::RollPlaneVehicle => &vars::ROLL_PLANE_VEHICLE,
+            Kind::CoupledSystem => &vars::COUPLED_SYSTEM,
+        }
+    }
+}
+
+impl crate::fmu::Instance {
+    /// Which FMU this instance is.
+    pub fn kind(&self) -> Kind {
+        Kind::from_guid(self.table().guid).expect("an instance of one of the three FMUs")
+    }
+
+    /// The scenario the variables of a track-carrying FMU describe.
+    pub fn scenario(&self) -> crate::params::Scenario {
+        scenario(self.kind(), self.values())
+    }
+}

@@ -1,0 +1,117 @@
+//! The engine's parameters from the FMU variables (by value reference), one function
+//! per engine struct.
+
+use super::Kind;
+use crate::contact::ContactModel;
+use crate::cosim::VehicleUnitParams;
+use crate::fmu::vars::{FLAT_VRS, enums, vr};
+use crate::params::{Scenario, TrackSpec, VehicleSpec};
+use crate::profile::{FlatShape, FlatSpec};
+use crate::track::{RailEnds, RailSection, TrackParams};
+use crate::vehicle::RollPlaneParams;
+
+/// Track parameters (fixed rail ends).
+pub fn track_params(v: &[f64]) -> TrackParams {
+    let v = |r: u32| v[r as usize];
+    TrackParams {
+        spans: v(vr::TRACK_SPANS) as usize,
+        nodes_per_span: v(vr::TRACK_NODES_PER_SPAN) as usize,
+        sleeper_spacing: v(vr::TRACK_SLEEPER_SPACING),
+        rail_seat_distance: v(vr::TRACK_RAIL_SEAT_DISTANCE),
+        rail: RailSection {
+            ei: v(vr::TRACK_RAIL_EI),
+            kag: v(vr::TRACK_RAIL_KAG),
+            mass: v(vr::TRACK_RAIL_MASS),
+            rotary_inertia: v(vr::TRACK_RAIL_ROTARY_INERTIA),
+        },
+        pad_stiffness: v(vr::TRACK_PAD_STIFFNESS),
+        pad_damping: v(vr::TRACK_PAD_DAMPING),
+        ballast_stiffness: v(vr::TRACK_BALLAST_STIFFNESS),
+        ballast_damping: v(vr::TRACK_BALLAST_DAMPING),
+        sleeper_mass: v(vr::TRACK_SLEEPER_MASS),
+        sleeper_inertia: v(vr::TRACK_SLEEPER_INERTIA),
+        ends: RailEnds::Fixed,
+    }
+}
+
+/// Roll-plane vehicle parameters (table 4.4 by default).
+pub fn vehicle_params(v: &[f64]) -> RollPlaneParams {
+    let v = |r: u32| v[r as usize];
+    RollPlaneParams {
+        carbody_mass: v(vr::VEHICLE_CARBODY_MASS),
+        bolster_mass: v(vr::VEHICLE_BOLSTER_MASS),
+        bolster_inertia: v(vr::VEHICLE_BOLSTER_INERTIA),
+        sideframe_mass: v(vr::VEHICLE_SIDEFRAME_MASS),
+        wheelset_mass: v(vr::VEHICLE_WHEELSET_MASS),
+        wheelset_inertia: v(vr::VEHICLE_WHEELSET_INERTIA),
+        primary_stiffness: v(vr::VEHICLE_PRIMARY_STIFFNESS),
+        primary_damping: v(vr::VEHICLE_PRIMARY_DAMPING),
+        primary_spacing: v(vr::VEHICLE_PRIMARY_SPACING),
+        secondary_stiffness: v(vr::VEHICLE_SECONDARY_STIFFNESS),
+        secondary_damping: v(vr::VEHICLE_SECONDARY_DAMPING),
+        secondary_spacing: v(vr::VEHICLE_SECONDARY_SPACING),
+        gravity: v(vr::GRAVITY),
+    }
+}
+
+/// The vehicle as a co-simulation unit (RollPlaneVehicle).
+pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
+    VehicleUnitParams {
+        vehicle: vehicle_params(v),
+        speed: v[vr::SPEED as usize],
+        wheel_radius: v[vr::WHEEL_RADIUS as usize],
+        dt: v[vr::SOLVER_DT as usize],
+        static_wheel_z: [
+            v[vr::STATIC_WHEEL_Z_LEFT as usize],
+            v[vr::STATIC_WHEEL_Z_RIGHT as usize],
+        ],
+    }
+}
+
+/// The scenario the variables of a track-carrying FMU describe: CoupledSystem carries
+/// the roll-plane vehicle, TrackContact external wheels with the given static loads.
+pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
+    let val = |r: u32| v[r as usize];
+    let flats = [0, 1].map(|side| {
+        FLAT_VRS[side]
+            .iter()
+            .map(|f| {
+                let depth = val(f[1]);
+                FlatSpec {
+                    length: val(f[0]),
+                    depth: if depth == 0.0 { None } else { Some(depth) },
+                    angle: val(f[2]),
+                    shape: if val(f[3]) == enums::flat_shape::CHORD {
+                        FlatShape::Chord
+                    } else {
+                        FlatShape::Haversine
+                    },
+                }
+            })
+            .collect::<Vec<_>>()
+    });
+    let vehicle = match kind {
+        Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
+        _ => VehicleSpec::External {
+            static_load: [val(vr::STATIC_LOAD_LEFT), val(vr::STATIC_LOAD_RIGHT)],
+        },
+    };
+    Scenario {
+        name: kind.table().model_identifier.into(),
+        track: TrackSpec::Discrete(track_params(v)),
+        vehicle,
+        wheel_radius: val(vr::WHEEL_RADIUS),
+        flats,
+        // The table's range holds the enumeration to its items (checked at set).
+        contact_model: if val(vr::CONTACT_MODEL) == enums::contact_model::HERTZ {
+            ContactModel::Hertz
+        } else {
+            ContactModel::Adaptive
+        },
+        kw: val(vr::CONTACT_KW),
+        hertz_coefficient: val(vr::CONTACT_CH),
+        speed: val(vr::SPEED),
+        start_position: val(vr::START_POSITION),
+        dt: val(vr::SOLVER_DT),
+    }
+}

@@ -1,0 +1,316 @@
+//! The model behind each of the three FMUs, as the FMI 2.0 layer sees it: building
+//! from the variables, inputs, stepping on the model's own grid, health checks of the
+//! outputs, and the state vector of FMU states.
+
+use super::Kind;
+use super::outputs::Published;
+use super::parameters::{scenario, vehicle_unit_params};
+use crate::cosim::VehicleUnit;
+use crate::error::{Error, num};
+use crate::fmu::fmi2::{Model, OutputFault, StepFault};
+use crate::fmu::vars::{FmuTable, VarSpec, vr};
+use crate::limits::{
+    FORCE_LIMIT_FACTOR, MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL, force_limit, within,
+};
+use crate::params::TrackSpec;
+use crate::solver::{Sample, Simulation};
+
+/// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
+/// end's reflections raise the forces (the default start position, 1.37 m, is two
+/// spans from the other end).
+pub const END_ZONE_SPANS: f64 = 2.0;
+
+/// The engine behind an FMU.
+#[derive(Debug, Clone)]
+pub(super) enum Engine {
+    /// Track and contact (a simulation with external wheels), or the whole system.
+    Sim(Box<Simulation>),
+    /// The vehicle.
+    Vehicle(Box<VehicleUnit>),
+}
+
+/// The model of one of the three FMUs ([`Kind`]) behind the FMI 2.0 layer.
+#[derive(Debug, Clone)]
+pub struct FmuModel {
+    kind: Kind,
+    pub(super) engine: Engine,
+    pub(super) published: Published,
+    /// The warning that the wheel nears the fixed rail end was given.
+    end_warned: bool,
+}
+
+impl FmuModel {
+    /// Which FMU this is.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+
+    /// The coupled simulation of the track-carrying FMUs.
+    pub fn simulation(&self) -> Option<&Simulation> {
+        match &self.engine {
+            Engine::Sim(s) => Some(s),
+            Engine::Vehicle(_) => None,
+        }
+    }
+
+    /// The vehicle unit of RollPlaneVehicle.
+    pub fn vehicle_unit(&self) -> Option<&VehicleUnit> {
+        match &self.engine {
+            Engine::Vehicle(u) => Some(u),
+            Engine::Sim(_) => None,
+        }
+    }
+
+    /// Steps to take to the model time `end` (s): to the grid point nearest `end`
+    /// (track), or the vehicle's count of equal substeps; and the time the vehicle
+    /// is to advance by.
+    fn steps_to(&self, end: f64, clock: f64) -> (f64, f64) {
+        match &self.engine {
+            Engine::Sim(sim) => {
+                let target = (end / sim.dt()).round().max(0.0);
+                ((target - sim.steps() as f64).max(0.0), 0.0)
+            }
+            Engine::Vehicle(u) => {
+                let h = end - (u.time() + u.carried());
+                (u.steps_for(h, clock), h)
+            }
+        }
+    }
+}
+
+impl Model for FmuModel {
+    const CALCULATED: usize = 7;
+
+    fn build(table: &'static FmuTable, values: &[f64]) -> Result<Self, Error> {
+        let kind = Kind::from_guid(table.guid).ok_or_else(|| {
+            Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
+        })?;
+        let (engine, published) = match kind {
+            Kind::RollPlaneVehicle => {
+                let p = vehicle_unit_params(values);
+                let u = VehicleUnit::new(&p)?;
+                let published = Published {
+                    static_load: u.static_load(),
+                    static_wheel_z: p.static_wheel_z,
+                    step: u.dt_base(),
+                    critical_step: p.vehicle.critical_time_step(),
+                    kw_used: 0.0,
+                };
+                (Engine::Vehicle(Box::new(u)), published)
+            }
+            Kind::TrackContact | Kind::CoupledSystem => {
+                let sim = Simulation::new(&scenario(kind, values))?;
+                let published = Published {
+                    static_load: sim.static_load(),
+                    static_wheel_z: sim.wheel_z(),
+                    step: sim.dt(),
+                    critical_step: sim.critical_step(),
+                    kw_used: sim.contact_law().kw,
+                };
+                (Engine::Sim(Box::new(sim)), published)
+            }
+        };
+        Ok(FmuModel {
+            kind,
+            engine,
+            published,
+            end_warned: false,
+        })
+    }
+
+    fn calculated(&self) -> Vec<f64> {
+        self.published.to_array().to_vec()
+    }
+
+    /// TrackContact: the wheel heights when one of them changed, the axle rotation
+    /// when it changed (not at every step: the track turns the axle on at `V / R_w`
+    /// from the last rotation it was given, so setting a wheel height alone leaves it
+    /// turning). RollPlaneVehicle: the contact forces.
+    fn set_inputs(&mut self, values: &[f64], changed: &[u32]) -> Result<(), Error> {
+        let v = |r: u32| values[r as usize];
+        match (&mut self.engine, self.kind) {
+            (Engine::Sim(sim), Kind::TrackContact) => {
+                let rotation = changed.contains(&vr::WHEEL_ROTATION);
+                let heights = changed.iter().any(|&r| r != vr::WHEEL_ROTATION);
+                if heights {
+                    sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
+                }
+                if rotation {
+                    sim.set_rotation(v(vr::WHEEL_ROTATION))?;
+                }
+                Ok(())
+            }
+            (Engine::Vehicle(u), _) => {
+                u.set_forces([v(vr::CONTACT_LEFT_FORCE), v(vr::CONTACT_RIGHT_FORCE)])
+            }
+            _ => Ok(()),
+        }
+    }
+
+    type Outputs = Option<Sample>;
+
+    fn outputs(&self) -> Option<Sample> {
+        self.simulation().map(Simulation::sample)
+    }
+
+    fn output(&self, sample: &Option<Sample>, vr: u32) -> f64 {
+        self.output_value(vr, sample.as_ref())
+    }
+
+    /// A force beyond [`FORCE_LIMIT_FACTOR`] times the static wheel load (at least 2 MN)
+    /// is refused; for the FMUs whose forces are their own state (not TrackContact's,
+    /// which come back with other inputs) it stops the run.
+    fn check_output(&self, spec: &VarSpec, x: f64, time: f64) -> Result<(), OutputFault> {
+        let lim = force_limit(self.published.static_load);
+        if within(x, lim) || spec.unit != "N" {
+            return Ok(());
+        }
+        let cause = match self.kind {
+            Kind::TrackContact => {
+                "likely the wheel inputs press the wheel into the rail far beyond a running \
+                 wheel's overlap"
+            }
+            _ => "the run diverged, or its parameters are far from a railway",
+        };
+        Err(OutputFault {
+            message: format!(
+                "`{}` = {} N at t = {time} s is beyond {} N ({FORCE_LIMIT_FACTOR} times the \
+                 static wheel load), which no physical run reaches: {cause}",
+                spec.name,
+                num(x),
+                num(lim),
+            ),
+            stops_run: self.kind != Kind::TrackContact,
+        })
+    }
+
+    /// `stopTime` beyond the time the wheel reaches the end of the track.
+    fn initialised_warning(&self, start: f64, stop: Option<f64>) -> Option<String> {
+        let (stop, sim) = (stop?, self.simulation()?);
+        let t_end = sim.time_at_track_end()?;
+        if stop - start < t_end {
+            return None;
+        }
+        let s = sim.scenario();
+        let spans = match &s.track {
+            TrackSpec::Discrete(t) => {
+                ((s.start_position + s.speed * (stop - start)) / t.sleeper_spacing).ceil() + 2.0
+            }
+            TrackSpec::Lumped(_) => f64::NAN,
+        };
+        Some(format!(
+            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track at \
+             t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
+             stopTime",
+            start + t_end
+        ))
+    }
+
+    /// At most [`MAX_NODE_STEPS_PER_CALL`] rail-node updates (track) or
+    /// [`MAX_VEHICLE_STEPS_PER_CALL`] steps (vehicle).
+    fn work_refusal(&self, end: f64, clock: f64) -> Option<String> {
+        let (n, _) = self.steps_to(end, clock);
+        match &self.engine {
+            Engine::Sim(sim) => {
+                let cost = n * sim.rail_nodes() as f64;
+                (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
+                    format!(
+                        "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
+                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
+                         default track)",
+                        sim.dt(),
+                        sim.rail_nodes(),
+                        num(cost)
+                    )
+                })
+            }
+            Engine::Vehicle(u) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
+                format!(
+                    "{n} steps of solver.step = {} s; the most one call may do is \
+                     {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
+                    u.dt_base()
+                )
+            }),
+        }
+    }
+
+    /// The track-carrying FMUs step on their fixed grid `t_k = k solver.step` and stop
+    /// at the grid point nearest `end` (`k = round(end / solver.step)`): a step within
+    /// the master's clock rounding of a whole multiple of `solver.step` runs as that many
+    /// steps, the internal step never changes (the explicit scheme is not stable under
+    /// every sequence of step changes near its limit), and the model time never drifts
+    /// from the master's by more than half a step. RollPlaneVehicle cuts the step into
+    /// equal steps (see [`VehicleUnit::advance`]). CoupledSystem has no inputs: the
+    /// sample at the end of the step is final, so a value beyond the health bounds
+    /// there fails this step.
+    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), Error> {
+        let (n, h) = self.steps_to(end, clock);
+        match &mut self.engine {
+            Engine::Sim(sim) => {
+                sim.advance_steps(n as u64)?;
+                match self.kind {
+                    Kind::CoupledSystem => sim.check_sample(),
+                    _ => Ok(()),
+                }
+            }
+            Engine::Vehicle(u) if h > 0.0 => u.advance(h, clock),
+            Engine::Vehicle(_) => Ok(()),
+        }
+    }
+
+    fn step_fault(e: &Error) -> StepFault {
+        match e {
+            Error::OffTrack { .. } => StepFault::Ended,
+            Error::Diverged { .. } | Error::NonFinite { .. } => StepFault::Stopped,
+            _ => StepFault::Refused,
+        }
+    }
+
+    /// Once per run when the wheel comes within [`END_ZONE_SPANS`] sleeper spans of the
+    /// fixed rail end, where the end's reflections raise the impact forces (by 20 to
+    /// 35 % within the last span, table 4.4).
+    fn step_warning(&mut self, time: f64) -> Option<String> {
+        if self.end_warned {
+            return None;
+        }
+        let sim = self.simulation()?;
+        let TrackSpec::Discrete(p) = &sim.scenario().track else {
+            return None;
+        };
+        let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
+        let x = sim.position();
+        if x <= zone {
+            return None;
+        }
+        let m = format!(
+            "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans of \
+             the fixed rail end at {:.3} m: the end's reflections raise impact forces here (by \
+             20 to 35 % within the last span); keep the impacts of interest at least \
+             {END_ZONE_SPANS} spans from the ends (track.spans)",
+            p.length()
+        );
+        self.end_warned = true;
+        Some(m)
+    }
+
+    fn state_vector(&self) -> Result<Vec<f64>, Error> {
+        match &self.engine {
+            Engine::Vehicle(u) => Ok(u.state_vector()),
+            Engine::Sim(sim) => sim.state_vector(),
+        }
+    }
+
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<(), Error> {
+        match &mut self.engine {
+            Engine::Vehicle(u) => u.set_state_vector(v),
+            Engine::Sim(sim) => sim.set_state_vector(v),
+        }
+    }
+
+    fn model_time(&self) -> (f64, f64) {
+        match &self.engine {
+            Engine::Vehicle(u) => (u.time() + u.carried(), 0.0),
+            Engine::Sim(sim) => (sim.time(), 0.5 * sim.dt()),
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! What the FMI 2.0 layer needs from a model: the binding of a concrete model
+//! implements [`Model`], and [`super::Instance`] does the rest (state machine, value
+//! access through the variable table, clock checks, FMU states, logging).
+
+use crate::error::Error;
+use crate::fmu::vars::{FmuTable, VarSpec};
+
+/// How a failed step leaves the run (FMI 2.0, section 4.2.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepFault {
+    /// The arguments were refused before anything moved: `fmi2Error`, the instance
+    /// stays usable.
+    Refused,
+    /// The model ended the run (`fmi2Discard`, `fmi2Terminated` status true): outputs
+    /// can still be read.
+    Ended,
+    /// The state is beyond what a physical run reaches: `fmi2Error`, the run can only
+    /// be reset or restored from an FMU state.
+    Stopped,
+}
+
+/// A value an output must not take, found when it is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputFault {
+    /// Why, naming the variable, the value and the bound.
+    pub message: String,
+    /// The run cannot go on (the value is the model's own state, not the result of the
+    /// inputs a master may still change).
+    pub stops_run: bool,
+}
+
+/// A model behind the FMI 2.0 co-simulation layer.
+///
+/// Values are passed by value reference: `values[vr]` holds the current value of every
+/// parameter and input of the FMU (NaN for the others). Times are the model's own,
+/// counted from `startTime` of `fmi2SetupExperiment`.
+pub trait Model: Clone + Sized {
+    /// Number of calculated parameters FMU states store.
+    const CALCULATED: usize;
+
+    /// Builds the model of the FMU `table` from the parameter and input values, solving
+    /// its initial state.
+    ///
+    /// Errors: any parameter the model refuses, named with its value and allowed range.
+    fn build(table: &'static FmuTable, values: &[f64]) -> Result<Self, Error>;
+
+    /// The calculated parameters (fixed by [`Model::build`]), in the order FMU states
+    /// store them; [`Model::CALCULATED`] values.
+    fn calculated(&self) -> Vec<f64>;
+
+    /// Hands the model the inputs `changed` (value references) from `values`.
+    fn set_inputs(&mut self, values: &[f64], changed: &[u32]) -> Result<(), Error>;
+
+    /// What the outputs of one read are computed from (evaluated once per read call).
+    type Outputs;
+
+    /// The state the outputs of a read are computed from.
+    fn outputs(&self) -> Self::Outputs;
+
+    /// The value of the output or calculated parameter `vr`.
+    fn output(&self, outputs: &Self::Outputs, vr: u32) -> f64;
+
+    /// Checks a finite output value against the bounds of a physical run.
+    fn check_output(&self, spec: &VarSpec, value: f64, time: f64) -> Result<(), OutputFault>;
+
+    /// A warning at the end of initialisation (for instance a `stopTime` the model cannot
+    /// reach), given the experiment's `startTime` and `stopTime` (s).
+    fn initialised_warning(&self, start: f64, stop: Option<f64>) -> Option<String>;
+
+    /// Why a step to the model time `end` (s) would do more work than one call may,
+    /// given the master clock's rounding `clock` (s); `None` when it may be taken.
+    fn work_refusal(&self, end: f64, clock: f64) -> Option<String>;
+
+    /// Advances to the model time `end` (s), within the master clock's rounding `clock`
+    /// (s), with the inputs held.
+    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), Error>;
+
+    /// How an error of [`Model::advance_to`] leaves the run.
+    fn step_fault(e: &Error) -> StepFault;
+
+    /// A warning after a successful step at the communication time `time` (s), at most
+    /// once per run.
+    fn step_warning(&mut self, time: f64) -> Option<String>;
+
+    /// Everything that determines the continuation, for serialized FMU states.
+    fn state_vector(&self) -> Result<Vec<f64>, Error>;
+
+    /// Restores [`Model::state_vector`] into a model built from the same parameters.
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<(), Error>;
+
+    /// The model's time since `startTime` (s) and how far it may lie from the
+    /// communication time (s): the model steps on its own grid.
+    fn model_time(&self) -> (f64, f64);
+}

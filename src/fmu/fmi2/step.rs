@@ -1,0 +1,121 @@
+//! `fmi2DoStep` and the status functions: the master's clock, checked, and the model
+//! advanced to it.
+
+use super::calls::{Call, Phase};
+use super::instance::Instance;
+use super::model::{Model, StepFault};
+use super::status::{FmiResult, Status};
+use crate::error::num;
+
+impl<M: Model> Instance<M> {
+    /// `fmi2DoStep` from `t` (s) by `h` (s).
+    ///
+    /// The FMU's clock is the master's: it moves to `t + h` exactly, and the model
+    /// advances to the model time `t + h - startTime` ([`Model::advance_to`], which
+    /// rounds to its own grid within the clock's rounding).
+    ///
+    /// Refused before anything moves: `h` not finite and positive, `t + h == t`, `t`
+    /// not the FMU's time (to 64 units in the last place), a step past `stopTime`, a
+    /// step the model refuses as too much work for one call ([`Model::work_refusal`]).
+    /// A model error that ends the run gives `fmi2Discard` and the `fmi2Terminated`
+    /// status; one that stops it ([`StepFault::Stopped`]) gives `fmi2Error`, and the run
+    /// can then only be reset or restored from an FMU state.
+    pub fn do_step(&mut self, t: f64, h: f64) -> FmiResult {
+        self.check(Call::DoStep)?;
+        if !(h.is_finite() && h > 0.0) {
+            return self.refuse(
+                Status::Error,
+                format!("fmi2DoStep: communicationStepSize = {h} s; allowed: finite and > 0 s"),
+            );
+        }
+        // The master's clock may differ from `t + h` of the last call by its rounding.
+        let tol = 64.0 * f64::EPSILON * t.abs().max(self.time.abs());
+        if !t.is_finite() || (t - self.time).abs() > tol {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: currentCommunicationPoint = {t} s, but the FMU is at {} s \
+                     (the end of the last step; allowed: that time to within {} s, the \
+                     rounding of the clock)",
+                    self.time,
+                    num(tol)
+                ),
+            );
+        }
+        let end = t + h;
+        if end == t {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: communicationStepSize = {h:e} s does not move the clock at t = {t} s \
+                     (t + h == t in double precision); allowed: > {:e} s there",
+                    f64::EPSILON * t.abs()
+                ),
+            );
+        }
+        if let Some(stop) = self.stop_time.filter(|s| end > s + 1e-9 * (1.0 + s.abs())) {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: t + h = {end} s is past stopTime = {stop} s of fmi2SetupExperiment"
+                ),
+            );
+        }
+        // The rounding of the master's clock: a few units in the last place of the time.
+        let clock = 16.0 * f64::EPSILON * t.abs().max(end.abs());
+        // The model steps to the master's clock, not by the sum of the h it was given
+        // (which drifts from the clock by its rounding, 1e-7 s per call at 1e9 s).
+        let model_end = end - self.start_time;
+        let work = self
+            .model
+            .as_ref()
+            .and_then(|m| m.work_refusal(model_end, clock));
+        if let Some(w) = work {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi2DoStep: communicationStepSize = {h} s would take {w}; use shorter \
+                     communication steps"
+                ),
+            );
+        }
+        let r = match &mut self.model {
+            Some(m) => m.advance_to(model_end, clock),
+            None => Err(crate::Error::Unsupported(
+                "stepping before initialisation".into(),
+            )),
+        };
+        if let Err(e) = r {
+            match M::step_fault(&e) {
+                StepFault::Ended => {
+                    self.ended = true;
+                    self.phase = Phase::StepFailed;
+                }
+                // The state may be partly advanced and beyond the health bounds.
+                StepFault::Stopped => {
+                    self.failed = Some(e.to_string());
+                    self.phase = Phase::Error;
+                }
+                // Refused arguments: nothing moved.
+                StepFault::Refused => {}
+            }
+            return self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
+        }
+        self.time = end;
+        let warning = self.model.as_mut().and_then(|m| m.step_warning(end));
+        if let Some(w) = warning {
+            self.warn(&format!("fmi2DoStep: {w}"));
+        }
+        Ok(())
+    }
+
+    /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.
+    pub fn last_successful_time(&self) -> f64 {
+        self.time
+    }
+
+    /// `fmi2GetBooleanStatus(fmi2Terminated)`: the model ended the run.
+    pub fn terminated_by_model(&self) -> bool {
+        self.ended
+    }
+}

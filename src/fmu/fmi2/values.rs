@@ -1,0 +1,224 @@
+//! Value access through the variable table: every reference, type, causality, phase
+//! and range is checked against the FMU's table before anything is read or stored.
+
+use super::calls::{Call, Phase};
+use super::instance::Instance;
+use super::model::Model;
+use super::status::{FmiResult, Status};
+use crate::error::num;
+use crate::fmu::vars::{Causality, VarSpec, VarType};
+
+impl<M: Model> Instance<M> {
+    fn spec(&mut self, call: &str, r: u32) -> FmiResult<&'static VarSpec> {
+        match self.slot.get(r as usize).copied().flatten() {
+            Some(i) => Ok(&self.table.vars[i]),
+            None => self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: unknown value reference {r} for {}",
+                    self.table.model_identifier
+                ),
+            ),
+        }
+    }
+
+    /// The spec of a value reference already checked by [`Instance::spec`].
+    fn known_spec(&self, r: u32) -> &'static VarSpec {
+        &self.table.vars[self.slot[r as usize].unwrap_or_default()]
+    }
+
+    fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
+        let is_real = s.ty == VarType::Real;
+        if is_real != real {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: variable `{}` (value reference {}) is of type {:?}",
+                    s.name, s.vr, s.ty
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// Reads variables into `out` (Real or Integer/Enumeration by `real`). Outputs and
+    /// calculated parameters come from the model, checked: a non-finite value stops the
+    /// run, and so does a value the model's [`Model::check_output`] refuses with
+    /// `stops_run`.
+    fn get(&mut self, call: Call, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
+        self.check(call)?;
+        let call = call.name();
+        let mut needs_model = false;
+        for &r in vrs {
+            let s = self.spec(call, r)?;
+            self.check_type(call, s, real)?;
+            needs_model |= matches!(
+                s.causality,
+                Causality::Output | Causality::CalculatedParameter
+            );
+        }
+        if needs_model && self.phase == Phase::Error && self.failed.is_none() {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: no outputs: an internal error stopped the instance; call fmi2Reset"
+                ),
+            );
+        }
+        if needs_model {
+            if let Some(why) = &self.failed {
+                let m = format!(
+                    "{call}: no outputs: the run stopped at t = {} s ({why}); call fmi2Reset or \
+                     fmi2SetFMUstate",
+                    self.time
+                );
+                return self.refuse(Status::Error, m);
+            }
+            self.ensure_model()?;
+        }
+        let outputs = match &self.model {
+            Some(m) if needs_model => Some(m.outputs()),
+            _ => None,
+        };
+        for (o, &r) in out.iter_mut().zip(vrs) {
+            let s = self.known_spec(r);
+            let computed = !matches!(s.causality, Causality::Parameter | Causality::Input);
+            let model = self.model.as_ref().filter(|_| computed);
+            *o = match (model, &outputs) {
+                (Some(m), Some(x)) => m.output(x, s.vr),
+                _ if computed => f64::NAN,
+                _ => self.values[s.vr as usize],
+            };
+            if !o.is_finite() {
+                let (name, x) = (s.name, *o);
+                let why = format!("`{name}` = {x} at t = {} s is not finite", self.time);
+                self.failed = Some(why.clone());
+                self.phase = Phase::Error;
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{call}: {why}; the run cannot go on: call fmi2Reset or fmi2SetFMUstate"
+                    ),
+                );
+            }
+            let Some(m) = model else { continue };
+            if let Err(f) = m.check_output(s, *o, self.time) {
+                if f.stops_run {
+                    self.failed = Some(f.message.clone());
+                    self.phase = Phase::Error;
+                }
+                return self.refuse(Status::Error, format!("{call}: {}", f.message));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes variables (Real or Integer/Enumeration by `real`): every value is checked
+    /// before any is stored, so a refused call changes nothing.
+    fn set(&mut self, call: Call, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
+        self.check(call)?;
+        let call = call.name();
+        for (&r, &x) in vrs.iter().zip(vals) {
+            let s = self.spec(call, r)?;
+            self.check_type(call, s, real)?;
+            let settable = matches!(
+                (s.causality, self.phase),
+                (Causality::Input, _)
+                    | (
+                        Causality::Parameter,
+                        Phase::Instantiated | Phase::Initialization
+                    )
+            );
+            if !settable {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{call}: variable `{}` ({:?}) cannot be set in state {:?}{}",
+                        s.name,
+                        s.causality,
+                        self.phase,
+                        if s.causality == Causality::Parameter {
+                            "; parameters are fixed after initialisation (use fmi2Reset)"
+                        } else {
+                            ""
+                        }
+                    ),
+                );
+            }
+            if !x.is_finite() || x < s.min || x > s.max {
+                let unit = if s.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", s.unit)
+                };
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{call}: `{}` = {}{unit} is out of range; allowed: finite, {} <= {} <= {}{unit}",
+                        s.name,
+                        num(x),
+                        num(s.min),
+                        s.name,
+                        num(s.max)
+                    ),
+                );
+            }
+        }
+        let mut inputs = false;
+        for (&r, &x) in vrs.iter().zip(vals) {
+            let s = self.known_spec(r);
+            self.values[s.vr as usize] = x;
+            match s.causality {
+                Causality::Parameter => self.dirty = true,
+                _ => inputs = true,
+            }
+        }
+        // A set call that changed a parameter rebuilds the model (with every input)
+        // before it is next used; otherwise every reference of the call is an input.
+        if inputs && self.model.is_some() && !self.dirty {
+            self.sync_inputs(vrs)?;
+        }
+        Ok(())
+    }
+
+    /// `fmi2GetReal`.
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
+        self.get(Call::GetReal, vrs, out, true)
+    }
+
+    /// `fmi2GetInteger` (integers and enumerations).
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> FmiResult {
+        let mut tmp = vec![0.0; vrs.len()];
+        self.get(Call::GetInteger, vrs, &mut tmp, false)?;
+        for (o, t) in out.iter_mut().zip(tmp) {
+            *o = t as i32;
+        }
+        Ok(())
+    }
+
+    /// `fmi2SetReal`.
+    pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> FmiResult {
+        self.set(Call::SetReal, vrs, vals, true)
+    }
+
+    /// `fmi2SetInteger` (integers and enumerations).
+    pub fn set_integer(&mut self, vrs: &[u32], vals: &[i32]) -> FmiResult {
+        let tmp: Vec<f64> = vals.iter().map(|&x| x as f64).collect();
+        self.set(Call::SetInteger, vrs, &tmp, false)
+    }
+
+    /// Boolean and String access for an FMU without such variables: any value
+    /// reference is unknown (an empty request succeeds).
+    pub fn no_such_type(&mut self, call: &str, vrs: &[u32]) -> FmiResult {
+        match vrs.first() {
+            None => Ok(()),
+            Some(r) => self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: unknown value reference {r}: {} has no variables of this type",
+                    self.table.model_identifier
+                ),
+            ),
+        }
+    }
+}

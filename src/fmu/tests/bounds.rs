@@ -1,0 +1,331 @@
+//! Parameter ranges, health bounds and FMU states.
+
+use super::*;
+
+#[test]
+fn parameter_ranges_follow_from_physics_and_match_the_engine() {
+    for t in vars::FMUS {
+        for v in t.vars {
+            if v.causality != Causality::Parameter {
+                continue;
+            }
+            if let Some(r) = crate::limits::range(v.name) {
+                assert_eq!(
+                    (v.min, v.max),
+                    (r.min, r.max),
+                    "{} in {}",
+                    v.name,
+                    t.model_identifier
+                );
+            }
+        }
+    }
+    let cases: [(Kind, u32, f64, &str); 5] = [
+        (
+            Kind::RollPlaneVehicle,
+            vr::VEHICLE_PRIMARY_STIFFNESS,
+            1e308,
+            "vehicle.primary.stiffness",
+        ),
+        (
+            Kind::CoupledSystem,
+            vr::VEHICLE_BOLSTER_MASS,
+            1e308,
+            "vehicle.bolster.mass",
+        ),
+        (
+            Kind::CoupledSystem,
+            vr::VEHICLE_PRIMARY_DAMPING,
+            1e300,
+            "vehicle.primary.damping",
+        ),
+        (
+            Kind::TrackContact,
+            vr::TRACK_RAIL_MASS,
+            1e-300,
+            "track.rail.mass",
+        ),
+        (
+            Kind::RollPlaneVehicle,
+            vr::VEHICLE_SECONDARY_SPACING,
+            5e-324,
+            "vehicle.secondary.spacing",
+        ),
+    ];
+    for (kind, r, x, name) in cases {
+        let (mut i, _) = instance(kind);
+        let e = i.set_real(&[r], &[x]).unwrap_err();
+        assert!(e.message.contains(&format!("`{name}` =")), "{}", e.message);
+        assert!(e.message.contains("out of range"), "{}", e.message);
+    }
+}
+
+#[test]
+fn a_parameter_error_is_reported_once_at_exit_initialization() {
+    let (mut i, log) = instance(Kind::TrackContact);
+    i.set_real(&[vr::FLAT_LEFT_2_DEPTH], &[1e-3]).unwrap();
+    i.enter_initialization().unwrap();
+    let e = i.exit_initialization().unwrap_err();
+    assert!(e.message.contains("flat.left[2]"), "{}", e.message);
+    assert_eq!(log.lock().unwrap().len(), 1);
+}
+
+#[test]
+fn wheel_inputs_far_into_the_rail_stop_the_run_with_an_error() {
+    let (mut i, log) = instance(Kind::TrackContact);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.set_real(&[vr::WHEEL_LEFT_Z], &[-0.02]).unwrap();
+    let mut p = [0.0];
+    let e = i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap_err();
+    assert!(e.message.contains("`contact.left.force`"), "{}", e.message);
+    let e = i.do_step(0.0, 1e-4).unwrap_err();
+    assert_eq!(e.status, Status::Error);
+    assert!(
+        e.message.contains("contact.left.force (N)"),
+        "{}",
+        e.message
+    );
+    assert!(e.message.contains("t = 0 s"), "{}", e.message);
+    assert!(e.message.contains("wheel inputs"), "{}", e.message);
+    let e = i.do_step(0.0, 1e-4).unwrap_err();
+    assert!(e.message.contains("the run stopped"), "{}", e.message);
+    assert_eq!(log.lock().unwrap().len(), 3);
+    // Reset gives a fresh run.
+    i.reset().unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 1e-4).unwrap();
+}
+
+#[test]
+fn an_unreachable_stop_time_is_named_at_initialisation() {
+    let (mut i, log) = instance(Kind::CoupledSystem);
+    i.setup_experiment(0.0, Some(2.0)).unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let log = log.lock().unwrap();
+    assert_eq!(log.len(), 1);
+    // 30 spans of 0.685 m from 1.37 m at 70 km/h: the end at 0.986 s; 2 s needs
+    // 1.37 + 38.9 m of track, 59 spans, plus the two kept clear of the end.
+    assert!(
+        log[0].contains("stopTime = 2 s cannot be reached"),
+        "{}",
+        log[0]
+    );
+    assert!(log[0].contains("t = 0.986"), "{}", log[0]);
+    assert!(log[0].contains("track.spans >= 61"), "{}", log[0]);
+}
+
+#[test]
+fn the_communication_point_must_be_the_fmu_time_to_the_clock_rounding() {
+    // At t = 1e9 s a tolerance relative to 1 + |t| let 0.5 s jumps and steps back
+    // through with fmi2OK.
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.setup_experiment(1e9, None).unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    for t in [1e9 + 0.5, 1e9 - 0.4, 1e9 + 1e-4] {
+        let e = i.do_step(t, 1e-4).unwrap_err();
+        assert!(e.message.contains("but the FMU is at"), "{}", e.message);
+    }
+    // A few units in the last place are the master's rounding.
+    i.do_step(1e9 + 2.0 * 1.2e-7, 1e-4).unwrap();
+    assert_eq!(i.phase(), Phase::StepComplete);
+}
+
+#[test]
+fn contacts_and_suspensions_too_soft_to_carry_the_load_are_refused_at_initialisation() {
+    let cases: [(Kind, u32, f64, &str); 4] = [
+        (Kind::CoupledSystem, vr::CONTACT_CH, 1.0, "`contact.CH`"),
+        (Kind::TrackContact, vr::CONTACT_KW, 1e6, "`contact.Kw`"),
+        (
+            Kind::CoupledSystem,
+            vr::VEHICLE_PRIMARY_STIFFNESS,
+            1e4,
+            "`vehicle.primary.stiffness`",
+        ),
+        (
+            Kind::RollPlaneVehicle,
+            vr::VEHICLE_SECONDARY_STIFFNESS,
+            1e4,
+            "`vehicle.secondary.stiffness`",
+        ),
+    ];
+    for (kind, r, x, name) in cases {
+        let (mut i, log) = instance(kind);
+        if r == vr::CONTACT_CH {
+            i.set_integer(&[vr::CONTACT_MODEL], &[2]).unwrap();
+        }
+        i.set_real(&[r], &[x]).unwrap();
+        i.enter_initialization().unwrap();
+        let e = i.exit_initialization().unwrap_err();
+        assert!(e.message.contains(name), "{}", e.message);
+        assert_eq!(log.lock().unwrap().len(), 1);
+    }
+    // The longest chord flat would be 139 mm deep.
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.set_integer(&[vr::FLAT_LEFT_1_SHAPE], &[2]).unwrap();
+    i.set_real(
+        &[vr::FLAT_LEFT_1_DEPTH, vr::FLAT_LEFT_1_LENGTH],
+        &[0.0, 0.746],
+    )
+    .unwrap();
+    i.enter_initialization().unwrap();
+    let e = i.exit_initialization().unwrap_err();
+    assert!(e.message.contains("`flat.left[1].length`"), "{}", e.message);
+}
+
+#[test]
+fn a_state_saved_before_the_first_step_restores_in_a_fresh_instance() {
+    for kind in [
+        Kind::TrackContact,
+        Kind::RollPlaneVehicle,
+        Kind::CoupledSystem,
+    ] {
+        let (mut a, _) = instance(kind);
+        a.enter_initialization().unwrap();
+        a.exit_initialization().unwrap();
+        let state = a.get_state().unwrap();
+        let bytes = a.serialize(&state).unwrap();
+        let (mut b, _) = instance(kind);
+        let s = b.deserialize(&bytes).unwrap();
+        b.set_state(&s).unwrap();
+        for i in [&mut a, &mut b] {
+            i.do_step(0.0, 1e-3).unwrap();
+        }
+        let (mut x, mut y) = ([0.0; 2], [0.0; 2]);
+        let vrs = [vr::WHEEL_LEFT_Z, vr::CONTACT_LEFT_MAX_FORCE];
+        a.get_real(&vrs, &mut x).unwrap();
+        b.get_real(&vrs, &mut y).unwrap();
+        assert_eq!(x, y, "{kind:?}");
+    }
+}
+
+#[test]
+fn a_doctored_state_is_refused_and_leaves_the_instance_as_it_was() {
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 1e-3).unwrap();
+    let state = i.get_state().unwrap();
+    let b = i.serialize(&state).unwrap();
+    let guid = i.table().guid.len();
+    let time_at = MAGIC.len() + 8 + guid + 3;
+    let put = |at: usize, bytes: &[u8]| {
+        let mut c = b.clone();
+        c[at..at + bytes.len()].copy_from_slice(bytes);
+        c
+    };
+    for (bytes, why) in [
+        // the GUID's and the reason's lengths at their largest
+        (put(MAGIC.len(), &u64::MAX.to_le_bytes()), "truncated"),
+        (put(time_at + 16, &u64::MAX.to_le_bytes()), "truncated"),
+        // solver.step (the fifth calculated parameter) and the clock
+        (
+            put(time_at + 24 + 4 * 8, &1e300f64.to_le_bytes()),
+            "disagrees",
+        ),
+        (
+            put(time_at, &0.5f64.to_le_bytes()),
+            "disagrees with the model's clock",
+        ),
+    ] {
+        let e = i.deserialize(&bytes).unwrap_err();
+        assert!(e.message.contains(why), "{why}: {}", e.message);
+    }
+    assert_eq!(i.phase(), Phase::StepComplete);
+    i.do_step(1e-3, 1e-3).unwrap();
+}
+
+#[test]
+fn a_coupled_run_beyond_the_bounds_fails_the_step_that_got_there() {
+    // A contact 300 times stiffer than table 4.4's on a shear-soft rail: the first
+    // impact passes 20 times the static load. The step that ends there returns
+    // fmi2Error naming the force and not blaming inputs CoupledSystem has none of;
+    // the stopped run's state serialises and restores as stopped.
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.set_integer(&[vr::TRACK_SPANS], &[60]).unwrap();
+    i.set_real(
+        &[vr::CONTACT_KW, vr::CONTACT_CH, vr::TRACK_RAIL_KAG],
+        &[1e13, 0.0, 1e7],
+    )
+    .unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let h = 1e-3;
+    let mut k = 0;
+    let e = loop {
+        match i.do_step(k as f64 * h, h) {
+            Ok(()) => {
+                let mut p = [0.0];
+                i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+                assert!(p[0] < 20.0 * 107.7e3);
+            }
+            Err(e) => break e,
+        }
+        k += 1;
+        assert!(k < 100, "no impact beyond the bound");
+    };
+    assert!(
+        e.message.contains("contact.left.force (N)"),
+        "{}",
+        e.message
+    );
+    assert!(!e.message.contains("wheel inputs"), "{}", e.message);
+    assert_eq!(i.phase(), Phase::Error);
+    let state = i.get_state().unwrap();
+    let bytes = i.serialize(&state).unwrap();
+    let (mut fresh, _) = instance(Kind::CoupledSystem);
+    let restored = fresh.deserialize(&bytes).unwrap();
+    fresh.set_state(&restored).unwrap();
+    assert_eq!(fresh.phase(), Phase::Error);
+    let mut p = [0.0];
+    let e = fresh
+        .get_real(&[vr::CONTACT_LEFT_FORCE], &mut p)
+        .unwrap_err();
+    assert!(e.message.contains("the run stopped"), "{}", e.message);
+    fresh.reset().unwrap();
+    fresh.enter_initialization().unwrap();
+    fresh.exit_initialization().unwrap();
+}
+
+#[test]
+fn the_vehicle_follows_the_masters_clock_far_from_zero() {
+    // At t = 1e9 s each t + 1e-3 rounds by up to 6e-8 s; summing the h given drifted
+    // 1e-3 s from the clock over 2e4 calls.
+    let (mut v, _) = instance(Kind::RollPlaneVehicle);
+    v.setup_experiment(1e9, None).unwrap();
+    v.enter_initialization().unwrap();
+    v.exit_initialization().unwrap();
+    let mut t = 1e9;
+    for _ in 0..20_000 {
+        let next = t + 1e-3;
+        v.do_step(t, next - t).unwrap();
+        t = next;
+    }
+    let mut rot = [0.0];
+    v.get_real(&[vr::WHEEL_ROTATION], &mut rot).unwrap();
+    let model_time = rot[0] * 0.475 / (70.0 / 3.6);
+    let dt = real(&mut v, vr::SOLVER_STEP);
+    assert!(
+        (model_time - (t - 1e9)).abs() <= 1e-3 * dt + 1e-9,
+        "{model_time} against {}",
+        t - 1e9
+    );
+}
+
+#[test]
+fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
+    let (mut i, log) = instance(Kind::TrackContact);
+    i.set_real(&[vr::TRACK_BALLAST_STIFFNESS], &[0.0]).unwrap();
+    i.enter_initialization().unwrap();
+    let e = i.exit_initialization().unwrap_err();
+    assert!(
+        e.message.contains("`track.ballast.stiffness` = 0"),
+        "{}",
+        e.message
+    );
+    assert!(e.message.contains("rail deflection"), "{}", e.message);
+    assert_eq!(log.lock().unwrap().len(), 1);
+}

@@ -1,0 +1,208 @@
+//! The state machine, the variable table and value access.
+
+use super::*;
+
+#[test]
+fn default_start_values_are_the_reference_scenario() {
+    let (i, _) = instance(Kind::CoupledSystem);
+    let mut a = Simulation::new(&i.scenario()).unwrap();
+    let mut b = Simulation::new(&Scenario::table_4_4_flat()).unwrap();
+    for _ in 0..3000 {
+        assert_eq!(a.step().unwrap(), b.step().unwrap());
+    }
+    // The literal handshake defaults of the table equal what the models compute.
+    let w = match Scenario::table_4_4().vehicle {
+        VehicleSpec::RollPlane(p) => p.static_wheel_load(),
+        _ => unreachable!(),
+    };
+    let (t, _) = instance(Kind::TrackContact);
+    assert_eq!(t.value(vr::STATIC_LOAD_LEFT), w);
+    let sim = Simulation::new(&t.scenario()).unwrap();
+    assert_eq!(t.value(vr::WHEEL_LEFT_Z), sim.wheel_z()[0]);
+    let (v, _) = instance(Kind::RollPlaneVehicle);
+    assert_eq!(v.value(vr::STATIC_WHEEL_Z_LEFT), sim.wheel_z()[0]);
+    assert_eq!(v.value(vr::CONTACT_LEFT_FORCE), w);
+}
+
+#[test]
+fn docs_variables_md_is_the_generated_file() {
+    // build.rs generates it from the table; a stale copy fails here.
+    assert!(
+        include_str!("../../../docs/VARIABLES.md") == vars::VARIABLES_MD,
+        "docs/VARIABLES.md is stale: run `cargo build --release && cargo run --release \
+         --bin build_fmus -- fmu docs/VARIABLES.md`"
+    );
+    for t in vars::FMUS {
+        for v in t.vars {
+            assert!(vars::VARIABLES_MD.contains(&format!("| `{}` |", v.name)));
+        }
+    }
+}
+
+#[test]
+fn refusals_name_the_variable_and_leave_the_instance_usable() {
+    let (mut i, log) = instance(Kind::TrackContact);
+    assert!(i.do_step(0.0, 1e-5).is_err());
+    let e = i.set_real(&[vr::TRACK_PAD_STIFFNESS], &[-1.0]).unwrap_err();
+    assert_eq!(e.status, Status::Error);
+    assert!(
+        e.message.contains("`track.pad.stiffness` = -1 N/m"),
+        "{}",
+        e.message
+    );
+    assert_eq!(
+        i.value(vr::TRACK_PAD_STIFFNESS),
+        140e6,
+        "a refused set changes nothing"
+    );
+    let e = i.set_integer(&[vr::TRACK_SPANS], &[1]).unwrap_err();
+    assert!(e.message.contains("`track.spans` = 1"), "{}", e.message);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 1e-4).unwrap();
+    let mut p = [0.0];
+    i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+    assert!((p[0] - 107.66e3).abs() < 2e3);
+    assert_eq!(log.lock().unwrap().len(), 3, "each refusal logged once");
+}
+
+#[test]
+fn the_state_table_lists_every_function_once_in_enum_order() {
+    for (k, (call, name, _)) in CALLS.iter().enumerate() {
+        assert_eq!(*call as usize, k, "{name}");
+        assert_eq!(call.name(), *name);
+        assert_eq!(Call::from_name(name), Some(*call));
+    }
+    for p in ALL {
+        assert_eq!(Phase::from_u8(*p as u8), Some(*p));
+    }
+    assert_eq!(Phase::from_u8(6), None);
+}
+
+#[test]
+fn terminate_and_status_follow_the_state_table() {
+    let (mut i, log) = instance(Kind::TrackContact);
+    let last = |log: &Arc<Mutex<Vec<String>>>| log.lock().unwrap().last().cloned().unwrap();
+    for call in [Call::GetRealStatus, Call::GetBooleanStatus, Call::Terminate] {
+        assert_eq!(i.check(call).unwrap_err().status, Status::Error);
+        let m = last(&log);
+        assert!(
+            m.starts_with(&format!(
+                "{} is not allowed in state Instantiated",
+                call.name()
+            )),
+            "{m}"
+        );
+    }
+    i.enter_initialization().unwrap();
+    for call in [Call::GetRealStatus, Call::GetBooleanStatus] {
+        assert!(i.check(call).is_err());
+        assert!(last(&log).contains("in state Initialization"));
+    }
+    let e = i.terminate().unwrap_err();
+    assert_eq!(
+        e.message,
+        "fmi2Terminate is not allowed in state Initialization; allowed in: StepComplete, StepFailed"
+    );
+    i.exit_initialization().unwrap();
+    i.check(Call::GetRealStatus).unwrap();
+    i.terminate().unwrap();
+    assert_eq!(i.phase(), Phase::Terminated);
+    let e = i.terminate().unwrap_err();
+    assert!(
+        e.message
+            .starts_with("fmi2Terminate is not allowed in state Terminated"),
+        "{}",
+        e.message
+    );
+    assert!(e.message.contains("fmi2Reset"), "{}", e.message);
+    i.check(Call::GetBooleanStatus).unwrap();
+    i.reset().unwrap();
+    assert_eq!(i.phase(), Phase::Instantiated);
+    assert!(i.check(Call::GetRealStatus).is_err());
+}
+
+#[test]
+fn after_the_model_ended_the_run_steps_are_refused_and_outputs_readable() {
+    let (mut i, log) = instance(Kind::CoupledSystem);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 0.01).unwrap();
+    let e = i.do_step(0.01, 5.0).unwrap_err();
+    assert_eq!(e.status, Status::Discard);
+    assert_eq!(i.phase(), Phase::StepFailed);
+    assert!(i.terminated_by_model());
+    assert_eq!(i.last_successful_time(), 0.01);
+    let n = log.lock().unwrap().len();
+    for h in [1e-4, 5.0] {
+        let e = i.do_step(0.01, h).unwrap_err();
+        assert_eq!(e.status, Status::Error);
+        assert!(
+            e.message
+                .starts_with("fmi2DoStep is not allowed in state StepFailed; allowed in: StepComplete; the model ended the run at t = 0.01 s"),
+            "{}",
+            e.message
+        );
+        assert!(e.message.contains("use fmi2Reset"), "{}", e.message);
+    }
+    assert_eq!(log.lock().unwrap().len(), n + 2, "each refusal logged");
+    // Inputs can no longer be set; outputs and status can be read.
+    assert!(i.set_real(&[vr::SPEED], &[10.0]).is_err());
+    let mut p = [0.0];
+    i.get_real(&[vr::POSITION], &mut p).unwrap();
+    // The track stands at its grid point nearest 0.01 s.
+    let dt = real(&mut i, vr::SOLVER_STEP);
+    assert!((p[0] - (1.37 + (0.01 / dt).round() * dt * 70.0 / 3.6)).abs() < 1e-9);
+    i.check(Call::GetRealStatus).unwrap();
+    i.check(Call::GetBooleanStatus).unwrap();
+    // A state taken here restores the failed step.
+    let s = i.get_state().unwrap();
+    let b = i.serialize(&s).unwrap();
+    i.terminate().unwrap();
+    assert_eq!(i.phase(), Phase::Terminated);
+    assert!(i.terminated_by_model());
+    let d = i.deserialize(&b).unwrap();
+    i.set_state(&d).unwrap();
+    assert_eq!(i.phase(), Phase::StepFailed);
+    assert!(i.do_step(0.01, 1e-4).is_err());
+    i.reset().unwrap();
+    assert!(!i.terminated_by_model());
+    assert_eq!(i.phase(), Phase::Instantiated);
+}
+
+#[test]
+fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
+    let (mut i, _) = instance(Kind::RollPlaneVehicle);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 1e-3).unwrap();
+    let s = i.get_state().unwrap();
+    let b = i.serialize(&s).unwrap();
+    assert!(i.deserialize(&b).is_ok());
+    let put = |at: usize, x: f64| {
+        let mut c = b.clone();
+        c[at..at + 8].copy_from_slice(&x.to_le_bytes());
+        c
+    };
+    let guid = i.table().guid.len();
+    let time_at = MAGIC.len() + 8 + guid + 3;
+    // time, start time, the reason's length (0), seven calculated parameters, the
+    // value count
+    let values_at = time_at + 8 * 10 + 8;
+    for (at, x, why) in [
+        (b.len() - 8, f64::NAN, "model state"),
+        (b.len() - 8, f64::INFINITY, "model state"),
+        (time_at, -1.0, "stored time"),
+        (time_at + 8, f64::NAN, "start time NaN"),
+        (time_at + 24, f64::NAN, "calculated parameter"),
+        (values_at + 8 * vr::SPEED as usize, -5.0, "`speed` = -5"),
+        (
+            values_at + 8 * vr::GRAVITY as usize,
+            f64::NAN,
+            "`gravity` = NaN",
+        ),
+    ] {
+        let e = i.deserialize(&put(at, x)).unwrap_err();
+        assert!(e.message.contains(why), "{why}: {}", e.message);
+    }
+}

@@ -1,0 +1,55 @@
+//! Tests of the FMI layer with this project's models, through the Rust API of an
+//! instance (the C boundary has its own in `tests/fmi_ffi.rs` and `tests/fmi_fuzz.rs`).
+
+mod bounds;
+mod clock;
+mod machine;
+
+pub(super) use crate::fmu::fmi2::{ALL, MAGIC};
+pub(super) use crate::fmu::vars::{self, Causality, vr};
+pub(super) use crate::fmu::*;
+pub(super) use crate::params::{Scenario, VehicleSpec};
+pub(super) use crate::solver::Simulation;
+pub(super) use std::sync::{Arc, Mutex};
+
+pub(super) fn instance(kind: Kind) -> (Instance, Arc<Mutex<Vec<String>>>) {
+    let log = Arc::new(Mutex::new(Vec::new()));
+    let l2 = log.clone();
+    let logger: Logger = Box::new(move |_, _, m| l2.lock().unwrap().push(m.to_string()));
+    (Instance::new(kind.table(), "test", logger, false), log)
+}
+
+/// A calculated parameter or output of `i`.
+pub(super) fn real(i: &mut Instance, r: u32) -> f64 {
+    let mut x = [0.0];
+    i.get_real(&[r], &mut x).unwrap();
+    x[0]
+}
+
+/// The coupled simulation of a track-carrying instance.
+pub(super) fn simulation(i: &Instance) -> &Simulation {
+    i.model()
+        .and_then(FmuModel::simulation)
+        .expect("a track-carrying model")
+}
+
+pub(super) fn coupled(start: f64, params: &[(u32, f64)], integers: &[(u32, i32)]) -> Instance {
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.setup_experiment(start, None).unwrap();
+    for &(r, x) in params {
+        i.set_real(&[r], &[x]).unwrap();
+    }
+    for &(r, x) in integers {
+        i.set_integer(&[r], &[x]).unwrap();
+    }
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i
+}
+
+pub(super) const FORCES: [u32; 4] = [
+    vr::CONTACT_LEFT_FORCE,
+    vr::CONTACT_RIGHT_FORCE,
+    vr::WHEEL_LEFT_Z,
+    vr::POSITION,
+];
