@@ -7,7 +7,7 @@ use super::outputs::Published;
 use super::parameters::{scenario, vehicle_unit_params};
 use crate::cosim::VehicleUnit;
 use crate::error::{Error, num};
-use crate::fmu::fmi2::{Model, OutputFault, StepFault};
+use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
 use crate::fmu::vars::{FmuTable, VarSpec, vr};
 use crate::limits::{
     FORCE_LIMIT_FACTOR, MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL, force_limit, within,
@@ -74,6 +74,33 @@ impl FmuModel {
                 let h = end - (u.time() + u.carried());
                 (u.steps_for(h, clock), h)
             }
+        }
+    }
+    /// Why `n` steps are more than one call may do: at most
+    /// [`MAX_NODE_STEPS_PER_CALL`] rail-node updates (track) or
+    /// [`MAX_VEHICLE_STEPS_PER_CALL`] steps (vehicle).
+    fn work_refusal(&self, n: f64) -> Option<String> {
+        match &self.engine {
+            Engine::Sim(sim) => {
+                let cost = n * sim.rail_nodes() as f64;
+                (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
+                    format!(
+                        "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
+                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
+                         default track)",
+                        sim.dt(),
+                        sim.rail_nodes(),
+                        num(cost)
+                    )
+                })
+            }
+            Engine::Vehicle(u) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
+                format!(
+                    "{n} steps of solver.step = {} s; the most one call may do is \
+                     {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
+                    u.dt_base()
+                )
+            }),
         }
     }
 }
@@ -206,34 +233,6 @@ impl Model for FmuModel {
         ))
     }
 
-    /// At most [`MAX_NODE_STEPS_PER_CALL`] rail-node updates (track) or
-    /// [`MAX_VEHICLE_STEPS_PER_CALL`] steps (vehicle).
-    fn work_refusal(&self, end: f64, clock: f64) -> Option<String> {
-        let (n, _) = self.steps_to(end, clock);
-        match &self.engine {
-            Engine::Sim(sim) => {
-                let cost = n * sim.rail_nodes() as f64;
-                (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
-                    format!(
-                        "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
-                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
-                         default track)",
-                        sim.dt(),
-                        sim.rail_nodes(),
-                        num(cost)
-                    )
-                })
-            }
-            Engine::Vehicle(u) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
-                format!(
-                    "{n} steps of solver.step = {} s; the most one call may do is \
-                     {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
-                    u.dt_base()
-                )
-            }),
-        }
-    }
-
     /// The track-carrying FMUs step on their fixed grid `t_k = k solver.step` and stop
     /// at the grid point nearest `end` (`k = round(end / solver.step)`): a step within
     /// the master's clock rounding of a whole multiple of `solver.step` runs as that many
@@ -243,9 +242,12 @@ impl Model for FmuModel {
     /// equal steps (see [`VehicleUnit::advance`]). CoupledSystem has no inputs: the
     /// sample at the end of the step is final, so a value beyond the health bounds
     /// there fails this step.
-    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), Error> {
+    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), StepError> {
         let (n, h) = self.steps_to(end, clock);
-        match &mut self.engine {
+        if let Some(w) = self.work_refusal(n) {
+            return Err(StepError::TooMuchWork(w));
+        }
+        Ok(match &mut self.engine {
             Engine::Sim(sim) => {
                 sim.advance_steps(n as u64)?;
                 match self.kind {
@@ -255,7 +257,7 @@ impl Model for FmuModel {
             }
             Engine::Vehicle(u) if h > 0.0 => u.advance(h, clock),
             Engine::Vehicle(_) => Ok(()),
-        }
+        }?)
     }
 
     fn step_fault(e: &Error) -> StepFault {

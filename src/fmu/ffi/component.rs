@@ -134,6 +134,7 @@ impl Inner {
 }
 
 /// Claims the instance behind `c` for `call`, or refuses (busy: logged).
+#[inline]
 pub(super) fn enter<'a>(c: fmi2Component, call: Call) -> Option<&'a Component> {
     if c.is_null() {
         return None;
@@ -169,6 +170,7 @@ pub(super) fn enter<'a>(c: fmi2Component, call: Call) -> Option<&'a Component> {
 
 /// Runs `f` on the instance behind `c` after the state check of `call`, catching
 /// panics.
+#[inline]
 pub(super) fn with_inner(
     c: fmi2Component,
     call: Call,
@@ -211,6 +213,7 @@ pub(super) fn with_inner(
 }
 
 /// Runs `f` on the instance behind `c`; see [`with_inner`].
+#[inline]
 pub(super) fn with(
     c: fmi2Component,
     call: Call,

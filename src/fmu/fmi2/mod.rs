@@ -15,7 +15,7 @@ mod values;
 pub(crate) use calls::ALL;
 pub use calls::{Allowed, CALLS, Call, Phase};
 pub use instance::Instance;
-pub use model::{Model, OutputFault, StepFault};
+pub use model::{Model, OutputFault, StepError, StepFault};
 #[cfg(test)]
 pub(crate) use states::MAGIC;
 pub use states::Snapshot;

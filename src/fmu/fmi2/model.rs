@@ -19,6 +19,22 @@ pub enum StepFault {
     Stopped,
 }
 
+/// Why `fmi2DoStep` did not complete.
+#[derive(Debug)]
+pub enum StepError {
+    /// The step would do more work than one call may; nothing moved. What it would
+    /// take, with the numbers.
+    TooMuchWork(String),
+    /// The model's error.
+    Model(Error),
+}
+
+impl From<Error> for StepError {
+    fn from(e: Error) -> Self {
+        StepError::Model(e)
+    }
+}
+
 /// A value an output must not take, found when it is read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutputFault {
@@ -67,13 +83,12 @@ pub trait Model: Clone + Sized {
     /// reach), given the experiment's `startTime` and `stopTime` (s).
     fn initialised_warning(&self, start: f64, stop: Option<f64>) -> Option<String>;
 
-    /// Why a step to the model time `end` (s) would do more work than one call may,
-    /// given the master clock's rounding `clock` (s); `None` when it may be taken.
-    fn work_refusal(&self, end: f64, clock: f64) -> Option<String>;
-
     /// Advances to the model time `end` (s), within the master clock's rounding `clock`
     /// (s), with the inputs held.
-    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), Error>;
+    ///
+    /// Errors: [`StepError::TooMuchWork`] before anything moves when the step would do
+    /// more work than one call may; the model's errors.
+    fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), StepError>;
 
     /// How an error of [`Model::advance_to`] leaves the run.
     fn step_fault(e: &Error) -> StepFault;

@@ -3,7 +3,7 @@
 
 use super::calls::{Call, Phase};
 use super::instance::Instance;
-use super::model::{Model, StepFault};
+use super::model::{Model, StepError, StepFault};
 use super::status::{FmiResult, Status};
 use crate::error::num;
 
@@ -16,7 +16,7 @@ impl<M: Model> Instance<M> {
     ///
     /// Refused before anything moves: `h` not finite and positive, `t + h == t`, `t`
     /// not the FMU's time (to 64 units in the last place), a step past `stopTime`, a
-    /// step the model refuses as too much work for one call ([`Model::work_refusal`]).
+    /// step the model refuses as too much work for one call ([`StepError::TooMuchWork`]).
     /// A model error that ends the run gives `fmi2Discard` and the `fmi2Terminated`
     /// status; one that stops it ([`StepFault::Stopped`]) gives `fmi2Error`, and the run
     /// can then only be reset or restored from an FMU state.
@@ -66,24 +66,24 @@ impl<M: Model> Instance<M> {
         // The model steps to the master's clock, not by the sum of the h it was given
         // (which drifts from the clock by its rounding, 1e-7 s per call at 1e9 s).
         let model_end = end - self.start_time;
-        let work = self
-            .model
-            .as_ref()
-            .and_then(|m| m.work_refusal(model_end, clock));
-        if let Some(w) = work {
-            return self.refuse(
-                Status::Error,
-                format!(
-                    "fmi2DoStep: communicationStepSize = {h} s would take {w}; use shorter \
-                     communication steps"
-                ),
-            );
-        }
         let r = match &mut self.model {
             Some(m) => m.advance_to(model_end, clock),
-            None => Err(crate::Error::Unsupported(
+            None => Err(StepError::Model(crate::Error::Unsupported(
                 "stepping before initialisation".into(),
-            )),
+            ))),
+        };
+        let r = match r {
+            Err(StepError::TooMuchWork(w)) => {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "fmi2DoStep: communicationStepSize = {h} s would take {w}; use shorter \
+                         communication steps"
+                    ),
+                );
+            }
+            Err(StepError::Model(e)) => Err(e),
+            Ok(()) => Ok(()),
         };
         if let Err(e) = r {
             match M::step_fault(&e) {
