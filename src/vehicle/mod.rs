@@ -1,0 +1,19 @@
+//! Vehicle models and the alternative loads on the track.
+//!
+//! * [`RollPlaneVehicle`]: the seed's six-degree-of-freedom half-bogie roll-plane model
+//!   (3.1-3.3), `d = {z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`, with gravity on every body,
+//!   advanced by central differences with damping as in (3.25).
+//! * [`LumpedWheels`]: the chapter-2 lumped model's wheel (2.27, first equation), one
+//!   per side: half-wheelset mass on the series primary/secondary suspension, loaded by
+//!   the wheel load `W`.
+//! * [`LumpedTrack`]: the chapter-2 lumped track mass (2.27, second equation), one per rail.
+//!
+//! Roll angles are positive when they raise the right side (MODEL.md).
+
+mod lumped;
+mod roll_plane;
+#[cfg(test)]
+mod tests;
+
+pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
+pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
