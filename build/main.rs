@@ -7,12 +7,17 @@
 //! - `$OUT_DIR/VARIABLES.md`, the variables' documentation ([`variables_md`];
 //!   `docs/VARIABLES.md` is this file, committed: a unit test fails when it is stale,
 //!   and `cargo run --release --bin build_fmus -- fmu docs/VARIABLES.md` rewrites it);
+//! - `$OUT_DIR/documentation/<modelIdentifier>.html`, each FMU's
+//!   `documentation/index.html`: what the model is, its variables, how to couple it and
+//!   its limits, from the prose of `build/pages/` and the table ([`documentation`]);
+//!   `$OUT_DIR/documentation.rs` lists them for `build_fmus`, which packs them;
 //! - `$OUT_DIR/wheelflat_fmi2.h`, the C header of the exported FMI functions, by
 //!   cbindgen ([`c_header`]).
 //!
 //! [`table`] reads and checks the table; each generator is one file of this folder.
 
 mod c_header;
+mod documentation;
 mod model_description;
 mod rust_binding;
 mod table;
@@ -44,5 +49,14 @@ fn main() {
     )
     .unwrap();
     fs::write(out.join("VARIABLES.md"), variables_md::write(&table)).unwrap();
+    fs::create_dir_all(out.join("documentation")).unwrap();
+    for (fmu, guid) in table.fmus.iter().zip(&guids) {
+        fs::write(
+            out.join(format!("documentation/{}.html", fmu.id())),
+            documentation::write(&table, fmu, guid, &version),
+        )
+        .unwrap();
+    }
+    fs::write(out.join("documentation.rs"), documentation::index(&table)).unwrap();
     c_header::write(&out.join("wheelflat_fmi2.h"));
 }
