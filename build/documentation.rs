@@ -1,11 +1,13 @@
-//! Each FMU's `documentation/index.html`: what the model is, its variables, how to
-//! couple it and its limits. The prose is `build/pages/<modelIdentifier>.html` inside
-//! `build/pages/page.html`; the tables come from the variable table.
+//! Each FMU's `documentation/index.html`: what the model is, its variables, how to use
+//! it and its limits. `build/pages/page.html` is the page with these sections;
+//! `build/pages/<modelIdentifier>.html` gives the model's prose for them, three parts
+//! separated by the lines `<!-- use -->` and `<!-- limits -->`. The tables come from the
+//! variable table.
 //!
-//! Placeholders of the pages: `@INCLUDE name@` is `build/pages/name.html`;
-//! `@VARIABLES@` the FMU's variables; `@CONNECTIONS@` the variables that join
-//! TrackContact and RollPlaneVehicle; `@ID@`, `@VERSION@`, `@GUID@`, `@DESCRIPTION@`
-//! and `@BODY@` (in `page.html`) what their names say.
+//! Placeholders: `@INCLUDE name@` is `build/pages/name.html`; `@VARIABLES@` the FMU's
+//! variables; `@CONNECTIONS@` the variables that join TrackContact and
+//! RollPlaneVehicle; `@WHAT@`, `@USE@`, `@LIMITS@` the model's parts; `@ID@`,
+//! `@VERSION@`, `@GUID@` and `@DESCRIPTION@` what their names say.
 
 use crate::model_description::xml_escape;
 use crate::table::{Fmu, FmuVar, Table};
@@ -26,17 +28,20 @@ fn template(name: &str) -> String {
 
 /// The page of `fmu`, whose model description has GUID `guid`.
 pub fn write(table: &Table, fmu: &Fmu, guid: &str, version: &str) -> String {
-    let mut body = template(fmu.id());
-    while let Some(at) = body.find("@INCLUDE ") {
-        let end = at + body[at + 1..].find('@').expect("closed @INCLUDE name@") + 1;
-        let name = body[at + "@INCLUDE ".len()..end].to_string();
-        body.replace_range(at..=end, template(&name).trim_end());
+    let model = template(fmu.id());
+    let (what, usage, limits) = parts(fmu.id(), &model);
+    let mut page = template("page")
+        .replace("@WHAT@", what.trim_end())
+        .replace("@USE@", usage.trim_end())
+        .replace("@LIMITS@", limits.trim_end());
+    while let Some(at) = page.find("@INCLUDE ") {
+        let end = at + page[at + 1..].find('@').expect("closed @INCLUDE name@") + 1;
+        let name = page[at + "@INCLUDE ".len()..end].to_string();
+        page.replace_range(at..=end, template(&name).trim_end());
     }
-    let body = body
-        .replace("@VARIABLES@", &variables(table, fmu))
-        .replace("@CONNECTIONS@", &connections(table));
-    let page = template("page")
-        .replace("@BODY@", body.trim_end())
+    let page = page
+        .replace("@VARIABLES@", variables(table, fmu).trim_end())
+        .replace("@CONNECTIONS@", &connections(table))
         .replace("@ID@", fmu.id())
         .replace("@VERSION@", version)
         .replace("@GUID@", guid)
@@ -49,6 +54,17 @@ pub fn write(table: &Table, fmu: &Fmu, guid: &str, version: &str) -> String {
         );
     }
     page
+}
+
+/// The three parts of a model's prose: what it is, how to use it, its limits.
+fn parts<'a>(id: &str, model: &'a str) -> (&'a str, &'a str, &'a str) {
+    let split = |text: &'a str, marker: &str| {
+        text.split_once(marker)
+            .unwrap_or_else(|| panic!("{PAGES}/{id}.html: no line {marker:?}"))
+    };
+    let (what, rest) = split(model, "<!-- use -->\n");
+    let (usage, limits) = split(rest, "<!-- limits -->\n");
+    (what, usage, limits)
 }
 
 /// Unit and display unit of a Real variable (`m (mm)`), nothing for the others.
