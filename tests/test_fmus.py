@@ -4,11 +4,13 @@ instances. Run by the README's test command (after the FMUs are built)."""
 
 import ctypes
 import glob
+import html.parser
 import math
 import os
 import subprocess
 import sys
 import threading
+import zipfile
 
 import numpy as np
 import pytest
@@ -106,6 +108,60 @@ def test_shared_library_exports_every_fmi2_cs_function(paths):
     out = subprocess.run(["nm", "-D", "--defined-only", lib], capture_output=True, text=True, check=True).stdout
     names = {line.split()[-1] for line in out.splitlines() if line.strip()}
     assert set(FMI2_CS_FUNCTIONS) <= names
+
+
+class HtmlTables(html.parser.HTMLParser):
+    """The rows of a page's tables as lists of cell texts; fails on an element closed
+    out of order (void elements excepted)."""
+
+    VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
+
+    def __init__(self, text):
+        super().__init__(convert_charrefs=True)
+        self.rows, self.open, self.cell = [], [], None
+        self.feed(text)
+        self.close()
+        assert self.open == [], f"unclosed elements: {self.open}"
+
+    def handle_starttag(self, tag, attrs):
+        if tag not in self.VOID:
+            self.open.append(tag)
+        if tag == "tr":
+            self.rows.append([])
+        elif tag in ("td", "th"):
+            self.cell = ""
+
+    def handle_endtag(self, tag):
+        assert self.open and self.open[-1] == tag, f"</{tag}> closes {self.open[-1:]}"
+        self.open.pop()
+        if tag in ("td", "th"):
+            self.rows[-1].append(self.cell)
+            self.cell = None
+
+    def handle_data(self, data):
+        if self.cell is not None:
+            self.cell += data
+
+
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem"])
+def test_documentation_lists_every_variable_with_its_unit(paths, name):
+    from fmpy import read_model_description
+    with zipfile.ZipFile(paths[name]) as z:
+        page = z.read("documentation/index.html").decode("utf-8")
+    assert page.startswith("<!DOCTYPE html>")
+    md = read_model_description(paths[name])
+    assert md.guid in page
+    header = ["name", "causality", "variability", "type", "unit", "start", "min/max", "description"]
+    tables = HtmlTables(page).rows
+    assert header in tables
+    rows = {r[0]: r for r in tables if len(r) == len(header) and r != header}
+    assert sorted(rows) == sorted(v.name for v in md.modelVariables)
+    for v in md.modelVariables:
+        row = dict(zip(header, rows[v.name]))
+        unit = f"{v.unit} ({v.displayUnit})" if v.unit and v.displayUnit else (v.unit or "")
+        assert row["unit"] == unit, v.name
+        assert (row["causality"], row["variability"]) == (v.causality, v.variability), v.name
+        assert row["description"] == (v.description or ""), v.name
 
 
 # ------------------------------------------------------------------ coupling

@@ -1,0 +1,193 @@
+//! Each FMU's modelDescription.xml, with a GUID derived from its content: the
+//! variables in table order, the table's unit, type and log-category sections verbatim,
+//! and a ModelStructure whose dependencies come from the table's `dependencies` and
+//! `initialDependencies`.
+
+use crate::table::{Fmu, FmuVar, RAW_SECTIONS, Table};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+/// Escapes text for an XML (or HTML) attribute value or text node.
+pub fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// 128-bit FNV-1a of the content, formatted as a GUID.
+fn guid(content: &str) -> String {
+    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
+    for b in content.bytes() {
+        h ^= b as u128;
+        h = h.wrapping_mul(0x0000000001000000000000000000013B);
+    }
+    let x = format!("{h:032x}");
+    format!(
+        "{{{}-{}-{}-{}-{}}}",
+        &x[0..8],
+        &x[8..12],
+        &x[12..16],
+        &x[16..20],
+        &x[20..32]
+    )
+}
+
+/// The model description of `fmu` (package version `version`) and its GUID.
+pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
+    let id = fmu.id();
+    let fv = &fmu.vars;
+    let mut md = String::new();
+    let desc = xml_escape(&fmu.attrs["description"]);
+    writeln!(
+        md,
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription\n  \
+         fmiVersion=\"2.0\"\n  modelName=\"{id}\"\n  guid=\"@GUID@\"\n  \
+         description=\"{desc}\"\n  author=\"wheelflat developers\"\n  \
+         version=\"{version}\"\n  generationTool=\"wheelflat build.rs\"\n  \
+         variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"0\">\n  \
+         <CoSimulation\n    modelIdentifier=\"{id}\"\n    needsExecutionTool=\"false\"\n    \
+         canHandleVariableCommunicationStepSize=\"true\"\n    canInterpolateInputs=\"false\"\n    \
+         maxOutputDerivativeOrder=\"0\"\n    canRunAsynchronuously=\"false\"\n    \
+         canBeInstantiatedOnlyOncePerProcess=\"false\"\n    canNotUseMemoryManagementFunctions=\"true\"\n    \
+         canGetAndSetFMUstate=\"true\"\n    canSerializeFMUstate=\"true\"\n    \
+         providesDirectionalDerivative=\"false\"/>"
+    )
+    .unwrap();
+    for s in RAW_SECTIONS {
+        writeln!(md, "  {}", table.sections[s]).unwrap();
+    }
+    writeln!(
+        md,
+        "  <DefaultExperiment startTime=\"0\" stopTime=\"{}\" stepSize=\"{}\"/>\n  <ModelVariables>",
+        fmu.attrs["stopTime"], fmu.attrs["stepSize"]
+    )
+    .unwrap();
+    for (k, v) in fv.iter().enumerate() {
+        md.push_str(&scalar_variable(k + 1, v));
+    }
+    md.push_str("  </ModelVariables>\n  <ModelStructure>\n");
+    // 1-based indices of the FMU's ModelVariables.
+    let index: BTreeMap<&str, usize> = fv
+        .iter()
+        .enumerate()
+        .map(|(k, v)| (v.name(), k + 1))
+        .collect();
+    // One <Unknown> list: Outputs (dependencies on inputs) or InitialUnknowns
+    // (dependencies on the knowns of initialization mode).
+    let mut unknowns = |tag: &str, causalities: &[&str], attr: &str, inputs_only: bool| {
+        let list: Vec<&FmuVar> = fv
+            .iter()
+            .filter(|v| causalities.contains(&v.causality()))
+            .collect();
+        if list.is_empty() {
+            return;
+        }
+        writeln!(md, "    <{tag}>").unwrap();
+        for v in list {
+            let d = expand(table, fmu, &index, v.get(attr), inputs_only);
+            writeln!(
+                md,
+                "      <Unknown index=\"{}\"{}/>",
+                index[v.name()],
+                deps_attr(&d)
+            )
+            .unwrap();
+        }
+        writeln!(md, "    </{tag}>").unwrap();
+    };
+    unknowns("Outputs", &["output"], "dependencies", true);
+    unknowns(
+        "InitialUnknowns",
+        &["output", "calculatedParameter"],
+        "initialDependencies",
+        false,
+    );
+    md.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
+    let g = guid(&md);
+    (md.replace("@GUID@", &g), g)
+}
+
+/// One `<ScalarVariable>`, numbered `k` in a comment.
+fn scalar_variable(k: usize, v: &FmuVar) -> String {
+    let mut line = format!(
+        "    <!-- {k} -->\n    <ScalarVariable name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\"",
+        xml_escape(v.name()),
+        v.vr,
+        v.causality(),
+        v.get("variability").unwrap()
+    );
+    if let Some(i) = v.get("initial") {
+        write!(line, " initial=\"{i}\"").unwrap();
+    }
+    write!(
+        line,
+        " description=\"{}\">\n      <{}",
+        xml_escape(v.get("description").unwrap_or("")),
+        v.ty()
+    )
+    .unwrap();
+    for k in ["declaredType", "unit", "displayUnit", "start", "min", "max"] {
+        if let Some(x) = v.get(k) {
+            if v.ty() != "Real" && matches!(k, "unit" | "displayUnit") {
+                continue;
+            }
+            write!(line, " {k}=\"{}\"", xml_escape(x)).unwrap();
+        }
+    }
+    writeln!(line, "/>\n    </ScalarVariable>").unwrap();
+    line
+}
+
+/// The ModelVariables indices a dependency list names: plain names and prefixes with a
+/// trailing `*`, kept when they are inputs (`inputs_only`) or knowns of initialization
+/// mode. A plain name must exist in the table (catches typos); it may belong to
+/// another FMU.
+fn expand(
+    table: &Table,
+    fmu: &Fmu,
+    index: &BTreeMap<&str, usize>,
+    list: Option<&str>,
+    inputs_only: bool,
+) -> Vec<usize> {
+    let mut out = Vec::new();
+    for pat in list.unwrap_or("").split_whitespace() {
+        let mut hit = false;
+        for v in &fmu.vars {
+            let ok = if inputs_only {
+                v.causality() == "input"
+            } else {
+                v.is_known()
+            };
+            let m = match pat.strip_suffix('*') {
+                Some(prefix) => v.name().starts_with(prefix),
+                None => v.name() == pat,
+            };
+            if m {
+                hit = true;
+                if ok {
+                    out.push(index[v.name()]);
+                }
+            }
+        }
+        assert!(
+            hit || pat.ends_with('*') || table.names.contains_key(pat),
+            "{}: unknown name {pat}",
+            fmu.id()
+        );
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// ` dependencies="..." dependenciesKind="..."` of an `<Unknown>`.
+fn deps_attr(d: &[usize]) -> String {
+    let s: Vec<String> = d.iter().map(|x| x.to_string()).collect();
+    let kinds: Vec<&str> = d.iter().map(|_| "dependent").collect();
+    format!(
+        " dependencies=\"{}\" dependenciesKind=\"{}\"",
+        s.join(" "),
+        kinds.join(" ")
+    )
+}

@@ -1,0 +1,258 @@
+//! Reads and checks `modelDescription/variables.xml`, the one variable table, and
+//! resolves each FMU's view of it (overrides applied, variability and initial derived
+//! from the causality). Every generator reads the table through [`Table`].
+
+use quick_xml::Reader;
+use quick_xml::events::{BytesStart, Event};
+use std::collections::BTreeMap;
+
+/// Where the table lives, relative to the package root.
+pub const TABLE: &str = "modelDescription/variables.xml";
+
+/// The sections copied verbatim into every model description, in their order there.
+pub const RAW_SECTIONS: [&str; 3] = ["UnitDefinitions", "TypeDefinitions", "LogCategories"];
+
+/// Attributes of one element, unescaped.
+pub type Attrs = BTreeMap<String, String>;
+
+fn attrs(e: &BytesStart) -> Attrs {
+    e.attributes()
+        .map(|a| {
+            let a = a.expect("well-formed attribute in the variable table");
+            (
+                a.key.as_ref().to_string(),
+                a.normalized_value(quick_xml::XmlVersion::Explicit1_0)
+                    .expect("well-formed attribute value")
+                    .into_owned(),
+            )
+        })
+        .collect()
+}
+
+/// A variable of the table: its own attributes and per-FMU overrides.
+pub struct TableVar {
+    pub attrs: Attrs,
+    pub overrides: BTreeMap<String, Attrs>,
+}
+
+impl TableVar {
+    pub fn name(&self) -> &str {
+        &self.attrs["name"]
+    }
+}
+
+/// A variable as one FMU sees it.
+#[derive(Clone)]
+pub struct FmuVar {
+    /// Value reference: the variable's position in the table.
+    pub vr: usize,
+    /// Resolved attributes, `variability` and `initial` included.
+    pub a: Attrs,
+}
+
+impl FmuVar {
+    /// A non-empty attribute.
+    pub fn get(&self, k: &str) -> Option<&str> {
+        self.a.get(k).map(|s| s.as_str()).filter(|s| !s.is_empty())
+    }
+    pub fn name(&self) -> &str {
+        self.get("name").unwrap()
+    }
+    pub fn causality(&self) -> &str {
+        self.get("causality").unwrap()
+    }
+    pub fn ty(&self) -> &str {
+        self.get("type").unwrap()
+    }
+    /// Known in initialization mode: inputs and parameters with exact start values.
+    pub fn is_known(&self) -> bool {
+        matches!(self.causality(), "parameter" | "input")
+    }
+}
+
+/// An item of an enumeration type.
+pub struct Item {
+    pub name: String,
+    pub value: i64,
+    pub description: String,
+}
+
+/// One FMU: its `<Fmu>` attributes and its variables in ModelVariables order.
+pub struct Fmu {
+    pub attrs: Attrs,
+    pub vars: Vec<FmuVar>,
+}
+
+impl Fmu {
+    /// `modelIdentifier`.
+    pub fn id(&self) -> &str {
+        &self.attrs["modelIdentifier"]
+    }
+
+    /// The resolved attributes of the variable with value reference `vr`, if this FMU
+    /// has it.
+    pub fn var(&self, vr: usize) -> Option<&FmuVar> {
+        self.vars.iter().find(|v| v.vr == vr)
+    }
+}
+
+/// The whole table.
+pub struct Table {
+    pub fmus: Vec<Fmu>,
+    /// Every variable, in table (value reference) order.
+    pub vars: Vec<TableVar>,
+    /// [`RAW_SECTIONS`] as written in the table.
+    pub sections: BTreeMap<String, String>,
+    /// Enumeration items by type name, from TypeDefinitions.
+    pub enums: BTreeMap<String, Vec<Item>>,
+    /// Value reference by variable name.
+    pub names: BTreeMap<String, usize>,
+}
+
+impl Table {
+    /// Reads the table; panics naming what is wrong with it.
+    pub fn read(text: &str) -> Table {
+        let mut reader = Reader::from_str(text);
+        let mut fmus: Vec<Attrs> = Vec::new();
+        let mut vars: Vec<TableVar> = Vec::new();
+        let mut sections: BTreeMap<String, String> = BTreeMap::new();
+        loop {
+            let pos = reader.buffer_position() as usize;
+            match reader.read_event().expect("well-formed variable table") {
+                Event::Eof => break,
+                Event::Start(e) if RAW_SECTIONS.contains(&e.name().as_ref()) => {
+                    let name = e.name().as_ref().to_string();
+                    reader.read_to_end(e.name()).expect("closed section");
+                    let end = reader.buffer_position() as usize;
+                    let start = text[pos..].find('<').unwrap() + pos;
+                    sections.insert(name, text[start..end].to_string());
+                }
+                Event::Empty(e) if e.name().as_ref() == "Fmu" => fmus.push(attrs(&e)),
+                Event::Start(e) | Event::Empty(e) if e.name().as_ref() == "Variable" => {
+                    vars.push(TableVar {
+                        attrs: attrs(&e),
+                        overrides: BTreeMap::new(),
+                    });
+                }
+                Event::Empty(e) if e.name().as_ref() == "Override" => {
+                    let mut a = attrs(&e);
+                    let fmu = a.remove("fmu").expect("Override needs fmu=");
+                    vars.last_mut()
+                        .expect("Override inside a Variable")
+                        .overrides
+                        .insert(fmu, a);
+                }
+                _ => {}
+            }
+        }
+        for s in RAW_SECTIONS {
+            assert!(sections.contains_key(s), "the table lacks {s}");
+        }
+        let mut names = BTreeMap::new();
+        for (i, v) in vars.iter().enumerate() {
+            let name = v.name();
+            assert!(
+                names.insert(name.to_string(), i).is_none(),
+                "duplicate variable {name}"
+            );
+        }
+        let enums = enumerations(&sections["TypeDefinitions"]);
+        let fmus = fmus
+            .into_iter()
+            .map(|attrs| {
+                let vars = resolve(&attrs["modelIdentifier"], &vars);
+                Fmu { attrs, vars }
+            })
+            .collect();
+        Table {
+            fmus,
+            vars,
+            sections,
+            enums,
+            names,
+        }
+    }
+
+    /// The least and largest item value of enumeration type `ty`; its values must be
+    /// consecutive (the FMI layer accepts exactly that range).
+    pub fn enum_range(&self, ty: &str) -> (i64, i64) {
+        let values: Vec<i64> = self.enums[ty].iter().map(|x| x.value).collect();
+        let (lo, hi) = (*values.iter().min().unwrap(), *values.iter().max().unwrap());
+        assert_eq!(
+            (hi - lo + 1) as usize,
+            values.len(),
+            "{ty}: item values must be consecutive"
+        );
+        (lo, hi)
+    }
+}
+
+/// Enumeration items by type, from the TypeDefinitions section.
+fn enumerations(type_definitions: &str) -> BTreeMap<String, Vec<Item>> {
+    let mut enums: BTreeMap<String, Vec<Item>> = BTreeMap::new();
+    let mut r = Reader::from_str(type_definitions);
+    let mut current = String::new();
+    loop {
+        match r.read_event().expect("well-formed TypeDefinitions") {
+            Event::Eof => break,
+            Event::Start(e) if e.name().as_ref() == "SimpleType" => {
+                current = attrs(&e)["name"].clone();
+            }
+            Event::Empty(e) if e.name().as_ref() == "Item" => {
+                let a = attrs(&e);
+                enums.entry(current.clone()).or_default().push(Item {
+                    name: a["name"].clone(),
+                    value: a["value"].parse().expect("integer item value"),
+                    description: a.get("description").cloned().unwrap_or_default(),
+                });
+            }
+            _ => {}
+        }
+    }
+    enums
+}
+
+/// The variables of FMU `id`: overrides applied, variability and initial derived from
+/// the causality and type, start values required of parameters and inputs and dropped
+/// from the calculated ones.
+fn resolve(id: &str, vars: &[TableVar]) -> Vec<FmuVar> {
+    let mut fv = Vec::new();
+    for (i, v) in vars.iter().enumerate() {
+        if !v.attrs["fmus"].split_whitespace().any(|f| f == id) {
+            assert!(
+                !v.overrides.contains_key(id),
+                "override for {id} on a variable it lacks"
+            );
+            continue;
+        }
+        let mut a = v.attrs.clone();
+        if let Some(o) = v.overrides.get(id) {
+            for (k, val) in o {
+                a.insert(k.clone(), val.clone());
+            }
+        }
+        let c = a["causality"].clone();
+        let (variability, initial) = match (c.as_str(), a["type"].as_str()) {
+            ("parameter", _) => ("fixed", Some("exact")),
+            ("calculatedParameter", _) => ("fixed", Some("calculated")),
+            ("input", "Real") => ("continuous", None),
+            ("input", _) => ("discrete", None),
+            ("output", "Real") => ("continuous", Some("calculated")),
+            ("output", _) => ("discrete", Some("calculated")),
+            (c, _) => panic!("unknown causality {c}"),
+        };
+        a.insert("variability".into(), variability.into());
+        a.insert("initial".into(), initial.unwrap_or("").into());
+        if matches!(c.as_str(), "parameter" | "input") {
+            assert!(
+                a.get("start").is_some_and(|s| !s.is_empty()),
+                "{id}: {} needs a start value",
+                a["name"]
+            );
+        } else {
+            a.insert("start".into(), String::new());
+        }
+        fv.push(FmuVar { vr: i, a });
+    }
+    fv
+}
