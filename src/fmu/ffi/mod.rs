@@ -3,7 +3,7 @@
 //! ([`crate::fmu::CALLS`]), its pointers and arguments, and forwards to
 //! [`crate::fmu::Instance`] inside `catch_unwind`, so no panic crosses into the
 //! master. FMU states are owned by the instance that handed them out. cbindgen writes
-//! the C header of `exports.rs` (`build.rs`); a test compiles it against the official
+//! the C header of `exports.rs` (`build/c_header.rs`); a test compiles it against the official
 //! `fmi2Functions.h`.
 
 #![allow(non_camel_case_types, non_snake_case, clippy::missing_safety_doc)]

@@ -26,7 +26,7 @@ fn default_start_values_are_the_reference_scenario() {
 
 #[test]
 fn docs_variables_md_is_the_generated_file() {
-    // build.rs generates it from the table; a stale copy fails here.
+    // The build script (build/) generates it from the table; a stale copy fails here.
     assert!(
         include_str!("../../../docs/VARIABLES.md") == vars::VARIABLES_MD,
         "docs/VARIABLES.md is stale: run `cargo build --release && cargo run --release \
