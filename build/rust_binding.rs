@@ -1,6 +1,7 @@
 //! `$OUT_DIR/variables.rs`, the Rust binding of the table that `src/fmu/vars.rs`
 //! includes: the value references by name, the enumerations' item values, the flats'
-//! value references, and one `FmuTable` per FMU (identity, model description,
+//! value references, the quantity and side of every output and calculated parameter,
+//! and one `FmuTable` per FMU (identity, model description,
 //! variables with type, causality, start value, range and unit).
 
 use crate::table::{FmuVar, TABLE, Table};
@@ -54,6 +55,7 @@ pub fn write(table: &Table, guids: &[String]) -> String {
     writeln!(rust, "}}\n").unwrap();
     enumerations(&mut rust, table);
     flat_vrs(&mut rust, table);
+    quantities(&mut rust, table);
     for (fmu, g) in table.fmus.iter().zip(guids) {
         let id = fmu.id();
         writeln!(
@@ -186,4 +188,80 @@ fn var_spec(rust: &mut String, table: &Table, id: &str, v: &FmuVar) {
         v.get("unit").unwrap_or("")
     )
     .unwrap();
+}
+
+/// A computed variable's quantity and side: `contact.left.force` -> (`ContactForce`, 0),
+/// `wheel.rotation` -> (`WheelRotation`, 0), `static_load.right` -> (`StaticLoad`, 1).
+fn quantity_of(name: &str) -> (String, usize) {
+    let mut side = 0;
+    let mut q = String::new();
+    for seg in name.split('.') {
+        match seg {
+            "left" => side = 0,
+            "right" => side = 1,
+            _ => {
+                for word in seg.split('_') {
+                    let mut c = word.chars();
+                    if let Some(f) = c.next() {
+                        q.push(f.to_ascii_uppercase());
+                        q.extend(c.map(|ch| ch.to_ascii_lowercase()));
+                    }
+                }
+            }
+        }
+    }
+    (q, side)
+}
+
+/// The quantities of the outputs and calculated parameters (of any FMU), and each such
+/// value reference's quantity and side: the binding maps a quantity to the engine in
+/// one exhaustive match, so a new output of the table does not compile until it is
+/// mapped.
+fn quantities(rust: &mut String, table: &Table) {
+    let computed = |vr: usize| {
+        table.fmus.iter().any(|f| {
+            f.var(vr)
+                .is_some_and(|v| matches!(v.causality(), "output" | "calculatedParameter"))
+        })
+    };
+    let mut kinds: Vec<(String, String)> = Vec::new();
+    let mut per_vr = Vec::new();
+    for (vr, v) in table.vars.iter().enumerate() {
+        if !computed(vr) {
+            per_vr.push("None".to_string());
+            continue;
+        }
+        let (q, side) = quantity_of(v.name());
+        if !kinds.iter().any(|(k, _)| *k == q) {
+            let generic = v
+                .name()
+                .split('.')
+                .map(|s| if s == "left" || s == "right" { "*" } else { s })
+                .collect::<Vec<_>>()
+                .join(".");
+            kinds.push((q.clone(), generic));
+        }
+        per_vr.push(format!("Some((Quantity::{q}, {side}))"));
+    }
+    writeln!(
+        rust,
+        "/// What an output or calculated parameter is, one item per quantity (a left/right\n\
+         /// pair is one quantity).\n\
+         #[derive(Debug, Clone, Copy, PartialEq, Eq)]\npub enum Quantity {{"
+    )
+    .unwrap();
+    for (q, generic) in &kinds {
+        writeln!(rust, "    /// `{generic}`\n    {q},").unwrap();
+    }
+    writeln!(
+        rust,
+        "}}\n\n/// The quantity and side (0 left, 1 right, 0 for quantities without a side) of\n\
+         /// each value reference that is an output or calculated parameter of an FMU.\n\
+         pub static QUANTITIES: [Option<(Quantity, usize)>; N_VR] = ["
+    )
+    .unwrap();
+    for q in per_vr {
+        writeln!(rust, "    {q},").unwrap();
+    }
+    writeln!(rust, "];\n").unwrap();
 }

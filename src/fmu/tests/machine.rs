@@ -206,3 +206,47 @@ fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
         assert!(e.message.contains(why), "{why}: {}", e.message);
     }
 }
+
+#[test]
+fn every_output_of_every_fmu_reads_its_quantity_from_the_engine() {
+    for kind in Kind::ALL {
+        let (mut i, _) = instance(kind);
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        i.do_step(0.0, 1e-3).unwrap();
+        for v in kind.table().vars {
+            if matches!(v.causality, Causality::Parameter | Causality::Input) {
+                continue;
+            }
+            assert!(
+                vars::QUANTITIES[v.vr as usize].is_some(),
+                "{kind:?}: `{}` has no quantity",
+                v.name
+            );
+            let x = if v.ty == vars::VarType::Real {
+                real(&mut i, v.vr)
+            } else {
+                let mut n = [0];
+                i.get_integer(&[v.vr], &mut n).unwrap();
+                n[0] as f64
+            };
+            assert!(x.is_finite(), "{kind:?}: `{}` = {x}", v.name);
+        }
+    }
+    // Left and right are the sides of the engine's arrays.
+    let (mut i, _) = instance(Kind::CoupledSystem);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.do_step(0.0, 1e-3).unwrap();
+    let s = simulation(&i).sample();
+    assert_eq!(real(&mut i, vr::CONTACT_RIGHT_FORCE), s.contact[1].force);
+    assert_eq!(real(&mut i, vr::CONTACT_LEFT_OVERLAP), s.contact[0].overlap);
+    assert_eq!(real(&mut i, vr::RAIL_RIGHT_Z), s.rail_z[1]);
+    assert_eq!(real(&mut i, vr::WHEEL_RIGHT_Z), s.wheel_z[1]);
+    let (d, bearing) = match simulation(&i).vehicle() {
+        crate::solver::VehicleState::RollPlane(v) => (*v.displacements(), v.bearing_forces()),
+        _ => unreachable!("CoupledSystem carries the roll-plane vehicle"),
+    };
+    assert_eq!(real(&mut i, vr::SIDEFRAME_RIGHT_Z), d[3]);
+    assert_eq!(real(&mut i, vr::PRIMARY_RIGHT_FORCE), bearing[1]);
+}
