@@ -13,7 +13,7 @@
 
 use crate::error::{Result, out_of_range, positive};
 use crate::numerics::{LANES, SMALL_ANGLE, SimdLevel, cos_poly, cos_small, inlined, wrap_angle};
-use crate::profile::{MAX_FLATS, WheelProfile};
+use crate::wheel::{FlattedWheel, MAX_FLATS, WheelProfile};
 use std::sync::OnceLock;
 
 /// Which normal-contact law to use.
@@ -328,10 +328,28 @@ pub fn adaptive_numeric(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f64)
     state
 }
 
+/// The adaptive law's state, written into `out`; by quadrature everywhere with
+/// `force_numeric`. Each kind of wheel profile has its own integral.
 #[inline(always)]
 fn adaptive(
     kw: f64,
     wheel: &WheelProfile,
+    gamma: f64,
+    overlap: f64,
+    force_numeric: bool,
+    out: &mut ContactState,
+) {
+    match wheel {
+        WheelProfile::Flatted(w) => flatted(kw, w, gamma, overlap, force_numeric, out),
+    }
+}
+
+/// [`adaptive`] for the nominal circle with flats: the closed form (2.5) when no flat
+/// reaches into the perfect-wheel patch, else the integral.
+#[inline(always)]
+fn flatted(
+    kw: f64,
+    wheel: &FlattedWheel,
     gamma: f64,
     overlap: f64,
     force_numeric: bool,
@@ -384,7 +402,7 @@ fn adaptive(
 #[inline(never)]
 fn adaptive_flats(
     kw: f64,
-    wheel: &WheelProfile,
+    wheel: &FlattedWheel,
     near: &[(f64, usize)],
     overlap: f64,
     delta: f64,
@@ -401,7 +419,7 @@ fn adaptive_flats(
 #[inline(always)]
 fn adaptive_flats_body(
     kw: f64,
-    wheel: &WheelProfile,
+    wheel: &FlattedWheel,
     near: &[(f64, usize)],
     overlap: f64,
     delta: f64,
@@ -782,7 +800,7 @@ fn gauss<G: Fn(&[f64; LANES]) -> [f64; LANES]>(g_lanes: &G, a: f64, b: f64) -> f
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::{FlatSpec, WheelProfile};
+    use crate::wheel::{FlatSpec, WheelProfile};
 
     const R: f64 = 0.475;
     const KW: f64 = 3.3443e10;

@@ -15,10 +15,10 @@ use crate::error::Error;
 use crate::error::num;
 use crate::limits::{MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL};
 use crate::params::{Scenario, TrackSpec, VehicleSpec};
-use crate::profile::{FlatShape, FlatSpec};
 use crate::solver::{Sample, Simulation, VehicleState};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
+use crate::wheel::{FlatShape, FlatSpec};
 use vars::{Causality, FLAT_VRS, FmuTable, N_VR, VarSpec, VarType, enums, vr};
 
 /// `fmi2Status`.
