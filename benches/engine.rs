@@ -7,8 +7,8 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
 use wheelflat::params::Scenario;
-use wheelflat::profile::{FlatSpec, WheelProfile};
 use wheelflat::solver::Simulation;
+use wheelflat::wheel::{FlatSpec, WheelProfile};
 
 /// Simulated time per benchmark iteration of the scaling and FMU groups (s).
 const SIM_TIME: f64 = 0.1;

@@ -5,8 +5,8 @@
 //! speed and grid, the worst phase, and the single-flat peak.
 //! `cargo run --release --example pair_phase_sweep`
 use wheelflat::params::{Scenario, TrackSpec, kmh};
-use wheelflat::profile::FlatSpec;
 use wheelflat::solver::Simulation;
+use wheelflat::wheel::FlatSpec;
 
 fn peak(s: &Scenario) -> f64 {
     let mut sim = Simulation::new(s).unwrap();

@@ -20,9 +20,9 @@
 use nalgebra::SymmetricEigen;
 use wheelflat::contact::ContactLaw;
 use wheelflat::params::{Scenario, TrackSpec, VehicleSpec};
-use wheelflat::profile::{FlatSpec, WheelProfile};
 use wheelflat::solver::Simulation;
 use wheelflat::track::{Track, TrackParams, perturbation_growth};
+use wheelflat::wheel::{FlatSpec, WheelProfile};
 
 /// Exact undamped limit `2 / sqrt(lambda_max)` (s) of the assembled track with a spring
 /// `kc` (N/m) to ground under the wheel at `x` (m) on the left rail.

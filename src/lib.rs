@@ -5,7 +5,7 @@
 //! sleepers, six-degree-of-freedom roll-plane vehicle, central finite differences)
 //! as a pure Rust library. See `../shared/MODEL.md` for conventions.
 //!
-//! Modules, bottom up: [`profile`] (wheel radius with flats), [`contact`] (normal
+//! Modules, bottom up: [`wheel`] (wheel radius with flats), [`contact`] (normal
 //! contact laws), [`track`] (rails, pads, sleepers, ballast), [`vehicle`] (roll-plane
 //! vehicle and the alternative loads), [`solver`] (the coupled time stepping),
 //! [`params`] (the seed's parameter sets).
@@ -20,9 +20,9 @@ pub mod fmu;
 pub mod limits;
 pub mod numerics;
 pub mod params;
-pub mod profile;
 pub mod solver;
 pub mod track;
 pub mod vehicle;
+pub mod wheel;
 
 pub use error::{Error, Result};

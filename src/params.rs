@@ -10,9 +10,9 @@
 //!   (it implies C_H ~ 1.0e10 N/m^1.5); the printed value is kept.
 
 use crate::contact::ContactModel;
-use crate::profile::FlatSpec;
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::{LumpedTrackParams, LumpedWheelParams, RollPlaneParams};
+use crate::wheel::FlatSpec;
 
 /// Which track model carries the loads.
 #[derive(Debug, Clone, Copy, PartialEq)]

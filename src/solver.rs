@@ -12,9 +12,9 @@ use crate::limits::{
     MIN_DT_FRACTION, force_limit, within,
 };
 use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
-use crate::profile::WheelProfile;
 use crate::track::{PointLoad, SimdLevel, Track};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use crate::wheel::WheelProfile;
 use std::cell::Cell;
 
 /// Track state of a simulation.

@@ -1,8 +1,13 @@
-//! Numerics with no physics in them: the instruction-set dispatch of the hot loops and
-//! the small-angle functions the wheel profile and the contact evaluate.
+//! Numerics with no physics in them: the instruction-set dispatch of the hot loops,
+//! the small-angle functions the wheel profile and the contact evaluate, root finding
+//! and Gauss-Legendre quadrature.
 
+mod quadrature;
+mod roots;
 mod simd;
 mod small_angle;
 
+pub(crate) use quadrature::gauss_legendre;
+pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};
 pub use small_angle::*;

@@ -6,9 +6,9 @@ use crate::contact::ContactModel;
 use crate::cosim::VehicleUnitParams;
 use crate::fmu::vars::{FLAT_VRS, enums, vr};
 use crate::params::{Scenario, TrackSpec, VehicleSpec};
-use crate::profile::{FlatShape, FlatSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
+use crate::wheel::{FlatShape, FlatSpec};
 
 /// Track parameters (fixed rail ends).
 pub fn track_params(v: &[f64]) -> TrackParams {

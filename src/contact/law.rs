@@ -1,0 +1,155 @@
+//! The contact law behind one interface: which law ([`ContactModel`]), its constants
+//! ([`ContactLaw`]), what it reports ([`ContactState`]), the dispatch to each law, and
+//! what every law gets from the dispatch: its stiffness and the overlap that carries a
+//! force.
+
+use super::{adaptive, hertz};
+use crate::error::{Result, positive};
+use crate::wheel::WheelProfile;
+
+/// Which normal-contact law to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactModel {
+    /// The seed's adaptive radial-spring contact (2.8).
+    Adaptive,
+    /// Hertz point contact `P = C_H (delta_c - f_0)^(3/2)` (1.3).
+    Hertz,
+}
+
+/// Contact law with its constants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactLaw {
+    /// Which law.
+    pub model: ContactModel,
+    /// Radial spring stiffness `K_w` (N/m/rad), used by the adaptive law.
+    pub kw: f64,
+    /// Hertz coefficient `C_H` (N/m^1.5), used by the Hertz law.
+    pub ch: f64,
+}
+
+/// What the contact model reports for one wheel at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactState {
+    /// Normal contact force `P` (N), >= 0, pushes the wheel up and the rail down.
+    pub force: f64,
+    /// Overlap `delta_c = z_rail - z_wheel` (m) (2.7); negative when apart.
+    pub overlap: f64,
+    /// Front contact angle `alpha_f` (rad), the foremost compressed spring (2.22);
+    /// 0 when out of contact.
+    pub front_angle: f64,
+    /// Rear contact angle `alpha_r` (rad), the rearmost compressed spring (2.22).
+    pub rear_angle: f64,
+    /// Contact length along the rail between the rear and front contact points (m),
+    /// `h (tan alpha_f - tan alpha_r)`.
+    pub length: f64,
+    /// Number of separate contact intervals (0: loss of contact, 2 or more: split patch).
+    pub intervals: u32,
+}
+
+impl ContactState {
+    /// True when the wheel has lost contact with the rail.
+    pub fn lost(&self) -> bool {
+        self.intervals == 0
+    }
+}
+
+impl ContactLaw {
+    /// An adaptive law with radial stiffness `kw` (N/m/rad) (2.1-2.8).
+    ///
+    /// # Errors
+    /// [`crate::Error::Parameter`] naming `contact.Kw` unless `kw` is finite and positive.
+    pub fn adaptive(kw: f64) -> Result<Self> {
+        positive("contact.Kw", kw, "N/m/rad")?;
+        Ok(ContactLaw {
+            model: ContactModel::Adaptive,
+            kw,
+            ch: 0.0,
+        })
+    }
+
+    /// A Hertz law with coefficient `ch` (N/m^1.5) (1.3).
+    ///
+    /// # Errors
+    /// [`crate::Error::Parameter`] naming `contact.CH` unless `ch` is finite and positive.
+    pub fn hertz(ch: f64) -> Result<Self> {
+        positive("contact.CH", ch, "N/m^1.5")?;
+        Ok(ContactLaw {
+            model: ContactModel::Hertz,
+            kw: 0.0,
+            ch,
+        })
+    }
+
+    /// Contact stiffness `dP / d delta` (N/m) at contact force `force` (N) for a wheel
+    /// with profile `wheel` at axle rotation `gamma` (rad), by a central difference
+    /// (relative step 1e-6) about the overlap that carries the force
+    /// ([`ContactLaw::overlap_for_force`]). For the adaptive law on a perfect wheel it is
+    /// `2 K_w alpha_w` (differentiating (2.5)); for Hertz `1.5 C_H delta^(1/2)`. The
+    /// linearised contact couples the rail under the wheel to the wheel in the explicit
+    /// scheme (the track's `critical_time_step_with_contact`).
+    pub fn stiffness(&self, wheel: &WheelProfile, gamma: f64, force: f64) -> f64 {
+        let d = self.overlap_for_force(wheel, gamma, force);
+        let e = 1e-6 * d;
+        let p = |x: f64| self.evaluate(wheel, gamma, x).force;
+        (p(d + e) - p(d - e)) / (2.0 * e)
+    }
+
+    /// Contact state for a wheel with profile `wheel` at axle rotation `gamma` (rad)
+    /// and overlap `overlap = z_rail - z_wheel` (m) (2.7): for the adaptive law the
+    /// integral of the compressed radial springs (2.8; closed form (2.5) where the
+    /// wheel is round), for Hertz (1.3) with the radius reduction under the wheel
+    /// centre. No contact (zero force, no intervals) when `overlap <= 0` or NaN.
+    #[inline(always)]
+    pub fn evaluate(&self, wheel: &WheelProfile, gamma: f64, overlap: f64) -> ContactState {
+        let mut state = ContactState::default();
+        self.evaluate_into(wheel, gamma, overlap, &mut state);
+        state
+    }
+
+    /// [`ContactLaw::evaluate`], the state written into `out`.
+    #[inline(always)]
+    pub(crate) fn evaluate_into(
+        &self,
+        wheel: &WheelProfile,
+        gamma: f64,
+        overlap: f64,
+        out: &mut ContactState,
+    ) {
+        // The coupled step writes the states where its sample keeps them: a state built
+        // in a temporary and copied at once stalled the copy's wide loads on the narrow
+        // stores that had just built it.
+        match self.model {
+            ContactModel::Adaptive => {
+                adaptive::adaptive(self.kw, wheel, gamma, overlap, false, out)
+            }
+            ContactModel::Hertz => *out = hertz::hertz(self, wheel, gamma, overlap),
+        }
+    }
+
+    /// Overlap (m) at which this law carries `force` (N) for the wheel at axle
+    /// rotation `gamma` (rad): the inverse of [`ContactLaw::evaluate`], by bisection to
+    /// 1e-16 relative; 0 for `force <= 0`.
+    pub fn overlap_for_force(&self, wheel: &WheelProfile, gamma: f64, force: f64) -> f64 {
+        if force <= 0.0 {
+            return 0.0;
+        }
+        let mut lo = 0.0;
+        let mut hi = 1e-4;
+        while self.evaluate(wheel, gamma, hi).force < force && hi < wheel.radius() {
+            lo = hi;
+            hi *= 2.0;
+        }
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if self.evaluate(wheel, gamma, mid).force < force {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            if hi - lo <= 1e-16 * hi {
+                break;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
