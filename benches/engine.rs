@@ -6,9 +6,8 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
-use wheelflat::params::Scenario;
 use wheelflat::profile::{FlatSpec, WheelProfile};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 
 /// Simulated time per benchmark iteration of the scaling and FMU groups (s).
 const SIM_TIME: f64 = 0.1;
@@ -102,7 +101,7 @@ fn fmu_step(c: &mut Criterion) {
     use std::ffi::CString;
     use wheelflat::fmu::ffi::*;
     use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
-    use wheelflat::params::VehicleSpec;
+    use wheelflat::sim::VehicleSpec;
 
     let mut g = c.benchmark_group("track_contact_per_0.1s");
     g.sample_size(10);

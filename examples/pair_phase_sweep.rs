@@ -4,9 +4,8 @@
 //! run with the left flat alone. Prints the peak impact force (either wheel) per
 //! speed and grid, the worst phase, and the single-flat peak.
 //! `cargo run --release --example pair_phase_sweep`
-use wheelflat::params::{Scenario, TrackSpec, kmh};
 use wheelflat::profile::FlatSpec;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec, kmh};
 
 fn peak(s: &Scenario) -> f64 {
     let mut sim = Simulation::new(s).unwrap();

@@ -19,9 +19,8 @@
 //! `cargo run --release --example stability_limit` (about 30 s).
 use nalgebra::SymmetricEigen;
 use wheelflat::contact::ContactLaw;
-use wheelflat::params::{Scenario, TrackSpec, VehicleSpec};
 use wheelflat::profile::{FlatSpec, WheelProfile};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec, VehicleSpec};
 use wheelflat::track::{Track, TrackParams, perturbation_growth};
 
 /// Exact undamped limit `2 / sqrt(lambda_max)` (s) of the assembled track with a spring

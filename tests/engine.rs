@@ -3,9 +3,8 @@
 
 use wheelflat::Error;
 use wheelflat::contact::ContactModel;
-use wheelflat::params::{Scenario, TrackSpec};
 use wheelflat::profile::FlatSpec;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec};
 
 fn seed_grid(mut s: Scenario) -> Scenario {
     s.set_nodes_per_span(2);

@@ -7,9 +7,8 @@
 
 use std::hint::black_box;
 use std::time::Instant;
-use wheelflat::params::Scenario;
 use wheelflat::profile::WheelProfile;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 
 fn main() {
     let mut s = Scenario::table_4_4_flat();

@@ -11,9 +11,8 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 use wheelflat::contact::ContactModel;
-use wheelflat::params::{Scenario, kmh};
 use wheelflat::profile::{FlatShape, FlatSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, kmh};
 
 const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:haversine|chord]]... [--no-flats] \

@@ -10,13 +10,14 @@ pub mod ffi;
 pub mod vars;
 
 use crate::contact::ContactModel;
-use crate::cosim::{VehicleUnit, VehicleUnitParams};
 use crate::error::Error;
 use crate::error::num;
 use crate::limits::{MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL};
-use crate::params::{Scenario, TrackSpec, VehicleSpec};
 use crate::profile::{FlatShape, FlatSpec};
-use crate::solver::{Sample, Simulation, VehicleState};
+use crate::sim::{
+    Sample, Scenario, Simulation, TrackSpec, VehicleSpec, VehicleState, VehicleUnit,
+    VehicleUnitParams,
+};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
 use vars::{Causality, FLAT_VRS, FmuTable, N_VR, VarSpec, VarType, enums, vr};

@@ -34,7 +34,7 @@ pub enum VehicleSpec {
     ConstantLoad([f64; 2]),
     /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
     /// displacements and the axle angle are inputs
-    /// ([`crate::solver::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`
+    /// ([`crate::sim::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`
     /// (N) is the load the external vehicle puts on each wheel at rest, used for the
     /// static start and for calibrating `K_w`.
     External {

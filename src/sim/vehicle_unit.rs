@@ -1,12 +1,12 @@
 //! The roll-plane vehicle as a co-simulation unit: driven by contact forces from
 //! outside, it reports wheel displacements and the axle angle. Its partner, the track
-//! with the contact, is a [`crate::solver::Simulation`] with
-//! [`crate::params::VehicleSpec::External`] wheels.
+//! with the contact, is a [`crate::sim::Simulation`] with
+//! [`crate::sim::VehicleSpec::External`] wheels.
 //!
 //! Coupled with a communication step equal to the track's step, in the order of
 //! `MODEL.md` (vehicle outputs -> track inputs -> track outputs -> vehicle inputs ->
 //! both step), the pair performs exactly the arithmetic of the monolithic
-//! [`crate::solver::Simulation`].
+//! [`crate::sim::Simulation`].
 
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within};
@@ -291,8 +291,7 @@ impl VehicleUnit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::{Scenario, VehicleSpec};
-    use crate::solver::Simulation;
+    use crate::sim::{Scenario, Simulation, VehicleSpec};
 
     /// Couples an external-wheel track simulation with a vehicle unit, as two FMUs
     /// would be coupled, and returns the contact forces per step.

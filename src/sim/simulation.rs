@@ -11,8 +11,8 @@ use crate::limits::{
     DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_STATIC_OVERLAP, MAX_STATIC_RAIL_DEFLECTION,
     MIN_DT_FRACTION, force_limit, within,
 };
-use crate::params::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::profile::WheelProfile;
+use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
 use crate::track::{PointLoad, SimdLevel, Track};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use std::cell::Cell;
