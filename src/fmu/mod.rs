@@ -12,7 +12,6 @@ pub mod vars;
 use crate::contact::ContactModel;
 use crate::error::Error;
 use crate::error::num;
-use crate::limits::{MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL};
 use crate::profile::{FlatShape, FlatSpec};
 use crate::sim::{
     Sample, Scenario, Simulation, TrackSpec, VehicleSpec, VehicleState, VehicleUnit,
@@ -1169,8 +1168,8 @@ impl Instance {
     /// is not stable under every sequence of step changes near its limit), and the
     /// model time never drifts from the master's by more than half a step. A step
     /// shorter than half a `solver.step` may advance no grid point; the outputs then
-    /// change only through the inputs. RollPlaneVehicle cuts `h` into equal steps (see
-    /// [`VehicleUnit::advance`]).
+    /// change only through the inputs ([`Simulation::advance_to`]). RollPlaneVehicle cuts
+    /// `h` into equal steps ([`VehicleUnit::advance_to`]).
     ///
     /// Refused: `h` not finite and positive, `t + h == t`, `t` not the FMU's time, a
     /// step past `stopTime`, a step that would cost more than
@@ -1202,10 +1201,6 @@ impl Instance {
             );
         }
         let end = t + h;
-        let start = self.start_time;
-        // The vehicle steps to the master's clock, not by the sum of the h it was given
-        // (which drifts from the clock by its rounding, 1e-7 s per call at 1e9 s).
-        let vehicle_step = |u: &VehicleUnit, end: f64| (end - start) - (u.time() + u.carried());
         if end == t {
             return self.refuse(
                 Status::Error,
@@ -1226,54 +1221,30 @@ impl Instance {
         }
         // The rounding of the master's clock: a few units in the last place of the time.
         let clock = 16.0 * f64::EPSILON * t.abs().max(end.abs());
-        // Steps to take: to the grid point nearest `end` (track), or the vehicle's count.
-        let n = match &self.model {
-            Some(Model::Sim(sim)) => {
-                let target = ((end - self.start_time) / sim.dt()).round().max(0.0);
-                (target - sim.steps() as f64).max(0.0)
-            }
-            Some(Model::Vehicle(u)) => u.steps_for(vehicle_step(u, end), clock),
-            None => 0.0,
-        };
-        let work = match &self.model {
-            Some(Model::Sim(sim)) => {
-                let cost = n * sim.rail_nodes() as f64;
-                (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
-                    format!(
-                        "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
-                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
-                         default track)",
-                        sim.dt(),
-                        sim.rail_nodes(),
-                        num(cost)
-                    )
-                })
-            }
-            Some(Model::Vehicle(u)) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
-                format!(
-                    "{n} steps of solver.step = {} s; the most one call may do is \
-                         {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
-                    u.dt_base()
-                )
-            }),
+        // The model's own clock starts at 0 at startTime.
+        let model_end = end - self.start_time;
+        // The steps to take, checked against the work limit before anything moves.
+        let plan = match &self.model {
+            Some(Model::Sim(sim)) => Some(sim.plan_to(model_end, clock)),
+            Some(Model::Vehicle(u)) => Some(u.plan_to(model_end, clock)),
             None => None,
         };
-        if let Some(w) = work {
-            return self.refuse(
-                Status::Error,
-                format!(
-                    "fmi2DoStep: communicationStepSize = {h} s would take {w}; use shorter \
-                     communication steps"
-                ),
-            );
-        }
-        let r = match &mut self.model {
-            Some(Model::Sim(sim)) => sim.advance_steps(n as u64),
-            Some(Model::Vehicle(u)) => {
-                let h = vehicle_step(u, end);
-                if h > 0.0 { u.advance(h, clock) } else { Ok(()) }
+        let plan = match plan.transpose() {
+            Ok(plan) => plan,
+            Err(w) => {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "fmi2DoStep: communicationStepSize = {h} s would take {w}; use shorter \
+                         communication steps"
+                    ),
+                );
             }
-            None => Err(Error::Unsupported("stepping before initialisation".into())),
+        };
+        let r = match (&mut self.model, plan) {
+            (Some(Model::Sim(sim)), Some(plan)) => sim.advance_to(plan),
+            (Some(Model::Vehicle(u)), Some(plan)) => u.advance_to(plan),
+            _ => Err(Error::Unsupported("stepping before initialisation".into())),
         };
         // CoupledSystem has no inputs: the sample at the end of the step is final (and
         // cached for the next step), so a value beyond the bounds there fails this step.

@@ -8,8 +8,11 @@
 //! both step), the pair performs exactly the arithmetic of the monolithic
 //! [`crate::sim::Simulation`].
 
+use super::clock::{Clock, ForceExtremes, StepPlan, Stepping};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within};
+use crate::limits::{
+    MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
+};
 use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
 use nalgebra::Vector6;
 
@@ -34,16 +37,18 @@ pub struct VehicleUnitParams {
 pub struct VehicleUnit {
     params: VehicleUnitParams,
     vehicle: RollPlaneVehicle,
-    dt_base: f64,
-    t0: f64,
-    k: u64,
-    /// Communication time not yet stepped (s): steps shorter than
-    /// [`MIN_STEP_FRACTION`] of the base step are carried over to the next call.
-    pending: f64,
+    /// Equal substeps of at most the base step; steps shorter than
+    /// [`MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
+    /// vehicle's.
+    clock: Clock,
     force: [f64; 2],
-    max_force: [f64; 2],
-    min_force: [f64; 2],
+    extremes: ForceExtremes,
 }
+
+/// Values of a [`VehicleUnit`] state vector ahead of the vehicle's: the clock
+/// (`t0`, `k`, the carried time), then the held forces `[left, right]` (N), then the
+/// force extremes.
+const HEAD: usize = 3 + 2 + ForceExtremes::LEN;
 
 impl VehicleUnit {
     /// Builds the vehicle at rest on the static wheel displacements.
@@ -81,13 +86,9 @@ impl VehicleUnit {
         let unit = VehicleUnit {
             params: *p,
             vehicle,
-            dt_base: dt,
-            t0: 0.0,
-            k: 0,
-            pending: 0.0,
+            clock: Clock::new(dt, Stepping::Substeps),
             force: [w, w],
-            max_force: [w, w],
-            min_force: [w, w],
+            extremes: ForceExtremes::at([w, w]),
         };
         unit.check_states()?;
         Ok(unit)
@@ -104,15 +105,15 @@ impl VehicleUnit {
     }
     /// Base step (s).
     pub fn dt_base(&self) -> f64 {
-        self.dt_base
+        self.clock.base
     }
     /// Time (s).
     pub fn time(&self) -> f64 {
-        self.t0 + self.k as f64 * self.vehicle.dt()
+        self.clock.time()
     }
     /// Communication time carried over to the next call, not yet stepped (s).
     pub fn carried(&self) -> f64 {
-        self.pending
+        self.clock.carried
     }
     /// Axle rotation angle `V t / R_w` (rad) (2.17).
     pub fn rotation(&self) -> f64 {
@@ -137,12 +138,12 @@ impl VehicleUnit {
     /// Largest contact force per wheel that has driven a step (N); the static load
     /// before the first step.
     pub fn max_force(&self) -> [f64; 2] {
-        self.max_force
+        self.extremes.max
     }
     /// Smallest contact force per wheel that has driven a step (N); the static load
     /// before the first step.
     pub fn min_force(&self) -> [f64; 2] {
-        self.min_force
+        self.extremes.min
     }
 
     /// Sets the contact forces `[left, right]` (N) held over the next communication step.
@@ -159,12 +160,7 @@ impl VehicleUnit {
     /// base step up to that rounding takes exactly that many steps; 0 when the sum is
     /// below [`MIN_STEP_FRACTION`] of the base step.
     pub fn steps_for(&self, h: f64, tolerance: f64) -> f64 {
-        let total = h + self.pending;
-        if total < MIN_STEP_FRACTION * self.dt_base {
-            0.0
-        } else {
-            ((total - tolerance) / self.dt_base).ceil().max(1.0)
-        }
+        self.clock.substeps(h, tolerance).n
     }
 
     /// Advances by a communication step `h` (s) with the contact forces held, in
@@ -182,27 +178,56 @@ impl VehicleUnit {
     /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`Error::Diverged`]).
     pub fn advance(&mut self, h: f64, tolerance: f64) -> Result<()> {
         positive("communication step", h, "s")?;
-        let n = self.steps_for(h, tolerance);
-        let total = h + self.pending;
-        if n == 0.0 {
-            self.pending = total;
+        let s = self.clock.substeps(h, tolerance);
+        if s.n == 0.0 {
+            self.clock.carried = s.total;
             return Ok(());
         }
-        self.pending = 0.0;
-        if (total - n * self.vehicle.dt()).abs() > tolerance {
-            self.t0 = self.time();
-            self.k = 0;
-            self.vehicle.change_dt(total / n)?;
+        self.clock.carried = 0.0;
+        if let Some(dt) = s.dt {
+            self.vehicle.change_dt(dt)?;
+            self.clock.restart(dt);
         }
-        for i in 0..2 {
-            self.max_force[i] = self.max_force[i].max(self.force[i]);
-            self.min_force[i] = self.min_force[i].min(self.force[i]);
-        }
-        for _ in 0..n as u64 {
+        self.extremes.record(self.force);
+        for _ in 0..s.n as u64 {
             self.vehicle.step(self.force);
-            self.k += 1;
+            self.clock.tick();
         }
         self.check_states()
+    }
+
+    /// Plans a communication step to the master's model time `end` (s), measured from
+    /// the start of the run: [`VehicleUnit::steps_for`] what `end` is ahead of the time
+    /// taken in ([`VehicleUnit::time`] and [`VehicleUnit::carried`]), `tolerance` (s)
+    /// the rounding of the master's clock. Following the master's clock rather than
+    /// summing its steps keeps the unit from drifting by the clock's rounding (1e-7 s
+    /// per call at 1e9 s).
+    ///
+    /// Refused before anything moves, with the reason in words: more than
+    /// [`MAX_VEHICLE_STEPS_PER_CALL`] steps.
+    pub fn plan_to(&self, end: f64, tolerance: f64) -> std::result::Result<StepPlan, String> {
+        let plan = self.clock.plan_to(end, tolerance);
+        let n = plan.steps;
+        if n > MAX_VEHICLE_STEPS_PER_CALL {
+            return Err(format!(
+                "{n} steps of solver.step = {} s; the most one call may do is \
+                 {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
+                self.clock.base
+            ));
+        }
+        Ok(plan)
+    }
+
+    /// Takes a communication step planned by [`VehicleUnit::plan_to`] with the contact
+    /// forces held: [`VehicleUnit::advance`] by what its end is ahead of the time taken
+    /// in; nothing when it is not ahead. Errors as [`VehicleUnit::advance`].
+    pub fn advance_to(&mut self, plan: StepPlan) -> Result<()> {
+        let h = plan.end - self.clock.reached();
+        if h > 0.0 {
+            self.advance(h, plan.tolerance)
+        } else {
+            Ok(())
+        }
     }
 
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
@@ -226,36 +251,35 @@ impl VehicleUnit {
         }
     }
 
-    /// Everything that determines the continuation; [`VehicleUnit::set_state_vector`]
-    /// restores it exactly.
+    /// Everything that determines the continuation: the clock (`t0` (s), `k`, the
+    /// carried time (s)), the held forces `[left, right]` (N), the largest and smallest
+    /// forces `[left, right]` (N), then the vehicle's step and displacements;
+    /// [`VehicleUnit::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
-        let mut v = vec![
-            self.t0,
-            self.k as f64,
-            self.pending,
-            self.force[0],
-            self.force[1],
-            self.max_force[0],
-            self.max_force[1],
-            self.min_force[0],
-            self.min_force[1],
-        ];
+        let c = &self.clock;
+        let mut v = vec![c.t0, c.k as f64, c.carried, self.force[0], self.force[1]];
+        v.extend(self.extremes.to_array());
         v.extend(self.vehicle.state_vector());
         v
     }
 
     /// Restores a state written by [`VehicleUnit::state_vector`] of a unit with the
-    /// same parameters.
+    /// same parameters. Refused: a wrong length, a clock that is not finite from 0 on, a
+    /// step count that is not a whole number below 2^53, a carried time not below the
+    /// least step, a force beyond 1e7 N, a step outside
+    /// [`MIN_STEP_FRACTION`]` dt_base ..= dt_base`, and a state beyond the health bounds
+    /// ([`VehicleUnit::check_states`]).
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        if v.len() != 22 {
+        let len = HEAD + self.vehicle.state_vector().len();
+        if v.len() != len {
             return Err(out_of_range(
                 "vehicle unit state length",
                 v.len() as f64,
-                "22 values",
+                format!("{len} values"),
             ));
         }
         let count = crate::limits::is_count;
-        let min_step = MIN_STEP_FRACTION * self.dt_base;
+        let min_step = MIN_STEP_FRACTION * self.clock.base;
         if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1]) && v[2] >= 0.0 && v[2] < min_step) {
             return Err(out_of_range(
                 "state: clock",
@@ -264,186 +288,26 @@ impl VehicleUnit {
                  below the least step",
             ));
         }
-        for &f in &v[3..9] {
+        for &f in &v[3..HEAD] {
             if !within(f, 1e7) {
                 return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
             }
         }
-        let dt = v[9];
-        if !(dt >= min_step && dt <= self.dt_base) {
+        let dt = v[HEAD];
+        if !(dt >= min_step && dt <= self.clock.base) {
             return Err(out_of_range(
                 "state: step",
                 dt,
-                format!("{} s <= dt <= {} s", num(min_step), num(self.dt_base)),
+                format!("{} s <= dt <= {} s", num(min_step), num(self.clock.base)),
             ));
         }
-        self.vehicle.set_state_vector(&v[9..])?;
-        self.t0 = v[0];
-        self.k = v[1] as u64;
-        self.pending = v[2];
+        self.vehicle.set_state_vector(&v[HEAD..])?;
+        self.clock.dt = self.vehicle.dt();
+        self.clock.t0 = v[0];
+        self.clock.k = v[1] as u64;
+        self.clock.carried = v[2];
         self.force = [v[3], v[4]];
-        self.max_force = [v[5], v[6]];
-        self.min_force = [v[7], v[8]];
+        self.extremes = ForceExtremes::from_slice(&v[5..HEAD]);
         self.check_states()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sim::{Scenario, Simulation, VehicleSpec};
-
-    /// Couples an external-wheel track simulation with a vehicle unit, as two FMUs
-    /// would be coupled, and returns the contact forces per step.
-    fn run_pair(s: &Scenario, h_per_dt: u64, steps: usize) -> Vec<[f64; 2]> {
-        let VehicleSpec::RollPlane(vp) = s.vehicle else {
-            panic!("roll-plane scenario expected")
-        };
-        let w = vp.static_wheel_load();
-        let mut ts = s.clone();
-        ts.vehicle = VehicleSpec::External {
-            static_load: [w, w],
-        };
-        let mut track = Simulation::new(&ts).unwrap();
-        let mut veh = VehicleUnit::new(&VehicleUnitParams {
-            vehicle: vp,
-            speed: s.speed,
-            wheel_radius: s.wheel_radius,
-            dt: 0.0,
-            static_wheel_z: track.wheel_z(),
-        })
-        .unwrap();
-        let h = track.dt() * h_per_dt as f64;
-        let mut out = Vec::new();
-        for _ in 0..steps {
-            track
-                .set_wheel_inputs(veh.wheel_z(), veh.rotation())
-                .unwrap();
-            let c = track.sample().contact;
-            let p = [c[0].force, c[1].force];
-            veh.set_forces(p).unwrap();
-            out.push(p);
-            track.advance_steps(h_per_dt).unwrap();
-            veh.advance(h, 0.0).unwrap();
-        }
-        out
-    }
-
-    #[test]
-    fn pair_at_the_track_step_is_the_monolithic_solver_bit_for_bit() {
-        let mut s = Scenario::table_4_4_flat();
-        s.set_nodes_per_span(2);
-        s.dt = 45e-6;
-        let steps = 4000; // 0.18 s: passes the first impact of the flat
-        let pair = run_pair(&s, 1, steps);
-        let mut sim = Simulation::new(&s).unwrap();
-        let mut peak = 0.0f64;
-        for (j, p) in pair.iter().enumerate() {
-            let m = sim.step().unwrap();
-            assert_eq!(
-                [m.contact[0].force, m.contact[1].force],
-                *p,
-                "step {j} differs"
-            );
-            peak = peak.max(p[0]);
-        }
-        // The run did reach the impact (well above the 107.7 kN static load).
-        assert!(peak > 300e3, "peak {peak}");
-    }
-
-    /// Table 4.4's vehicle at 20 m/s with step `dt` (0: the default) at rest on
-    /// `static_wheel_z`.
-    fn table_4_4_unit(
-        dt: impl Fn(&RollPlaneParams) -> f64,
-        static_wheel_z: [f64; 2],
-    ) -> VehicleUnitParams {
-        let VehicleSpec::RollPlane(vp) = Scenario::table_4_4().vehicle else {
-            unreachable!()
-        };
-        VehicleUnitParams {
-            vehicle: vp,
-            speed: 20.0,
-            wheel_radius: 0.475,
-            dt: dt(&vp),
-            static_wheel_z,
-        }
-    }
-
-    #[test]
-    fn state_vector_round_trip_continues_identically() {
-        let p = table_4_4_unit(|_| 0.0, [-1e-3, -1.1e-3]);
-        let mut a = VehicleUnit::new(&p).unwrap();
-        a.set_forces([150e3, 90e3]).unwrap();
-        a.advance(3.3e-3, 0.0).unwrap();
-        let mut b = VehicleUnit::new(&p).unwrap();
-        b.set_state_vector(&a.state_vector()).unwrap();
-        a.advance(1e-3, 0.0).unwrap();
-        b.advance(1e-3, 0.0).unwrap();
-        assert_eq!(a.state_vector(), b.state_vector());
-    }
-
-    #[test]
-    fn vehicle_default_step_resolves_its_fastest_mode() {
-        let s = Scenario::table_4_4();
-        let VehicleSpec::RollPlane(vp) = s.vehicle else {
-            unreachable!()
-        };
-        let w = vp.natural_frequencies();
-        // Free wheelset (rigid-body) modes are zero; the fastest is a wheelset mode on
-        // the primary springs: omega^2 = 2 k1 / m_w bounds it from below.
-        assert!(w[0].abs() < 1e-6 * w[5]);
-        assert!(w[5] >= (2.0 * vp.primary_stiffness / vp.wheelset_mass).sqrt() * 0.999);
-        let dt = vp.default_dt();
-        assert!((dt * w[5] - std::f64::consts::TAU / 50.0).abs() < 1e-12);
-        assert!(dt < vp.critical_time_step());
-    }
-
-    #[test]
-    fn any_sequence_of_communication_steps_stays_stable_and_close_to_fixed_steps() {
-        // solver.dt at its largest allowed value, half the critical step, and 1e5
-        // communication steps cycling through sizes that force a change of the step
-        // at almost every call. The wheels rest on linear springs fed back by the
-        // master (a stand-in track) and get a 10 ms push of half the static load.
-        let p = table_4_4_unit(|vp| 0.5 * vp.critical_time_step(), [-1.4e-3, -1.4e-3]);
-        let w = p.vehicle.static_wheel_load();
-        let forces = |u: &VehicleUnit, t: f64| {
-            let (z, k) = (u.wheel_z(), 2e7);
-            let push = if t < 0.01 { 0.5 * w } else { 0.0 };
-            [w - k * (z[0] + 1.4e-3) + push, w - k * (z[1] + 1.4e-3)]
-        };
-        let mut var = VehicleUnit::new(&p).unwrap();
-        let mut fixed = VehicleUnit::new(&p).unwrap();
-        let dt = var.dt_base();
-        // Seven sizes adding up to four steps: every seven calls both runs are at the
-        // same time and are compared there.
-        let sizes = [0.5, 1.0, 0.23, 0.77, 0.5, 0.1, 0.9];
-        let (mut t, mut tf) = (0.0, 0.0);
-        let (mut worst, mut largest) = (0.0f64, 0.0f64);
-        for k in 0..7 * 14_286 {
-            let h = sizes[k % sizes.len()] * dt;
-            var.set_forces(forces(&var, t)).unwrap();
-            var.advance(h, 0.0).unwrap();
-            t += h;
-            if k % sizes.len() == sizes.len() - 1 {
-                for _ in 0..4 {
-                    fixed.set_forces(forces(&fixed, tf)).unwrap();
-                    fixed.advance(dt, 0.0).unwrap();
-                    tf += dt;
-                }
-                let (a, b) = (var.wheel_z()[0] + 1.4e-3, fixed.wheel_z()[0] + 1.4e-3);
-                worst = worst.max((a - b).abs());
-                largest = largest.max(b.abs());
-            }
-        }
-        assert!((t - tf).abs() < 1e-9 * t, "{t} {tf}");
-        // 1e5 steps of on average 0.57 dt: 220 s. Bounded (advance checks the health
-        // bounds), and the left wheel's excursion from rest differs from the
-        // fixed-step run's by the first-order error of the step changes.
-        assert!(t > 200.0, "{t}");
-        assert!(
-            largest > 1e-3 && worst < 0.1 * largest,
-            "{worst} of {largest}"
-        );
-        println!("largest excursion {largest:e} m, largest difference {worst:e} m");
     }
 }
