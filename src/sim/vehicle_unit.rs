@@ -32,7 +32,11 @@ pub struct VehicleUnitParams {
     pub static_wheel_z: [f64; 2],
 }
 
-/// The six-DOF vehicle stepped by communication steps, with its inputs held.
+/// The six-DOF roll-plane vehicle (3.1-3.3, 3.24-3.27) as a co-simulation unit: the
+/// contact forces `[left, right]` (N) come in and are held over each communication step;
+/// the wheel-centre displacements (m), the axle angle (rad) and the bodies' motion go
+/// out. It follows the master's clock in equal substeps of at most its base step
+/// ([`VehicleUnit::plan_to`], [`VehicleUnit::advance`]).
 #[derive(Debug, Clone)]
 pub struct VehicleUnit {
     params: VehicleUnitParams,
@@ -51,7 +55,12 @@ pub struct VehicleUnit {
 const HEAD: usize = 3 + 2 + ForceExtremes::LEN;
 
 impl VehicleUnit {
-    /// Builds the vehicle at rest on the static wheel displacements.
+    /// Builds the vehicle at rest on the static wheel displacements, carrying the static
+    /// wheel load on each wheel.
+    ///
+    /// Errors: a parameter outside its physical range ([`Error::Parameter`], naming
+    /// it); a step outside [`MIN_DT_FRACTION`] of the critical step of the fastest
+    /// suspension mode up to half of it; a static state beyond the health bounds.
     pub fn new(p: &VehicleUnitParams) -> Result<Self> {
         check("speed", p.speed)?;
         check("wheel.radius", p.wheel_radius)?;

@@ -111,7 +111,7 @@ pub struct Wheelsets {
 
 impl Wheelsets {
     /// The list of one wheelset, `lead`.
-    pub fn new(lead: Wheelset) -> Wheelsets {
+    pub(crate) fn new(lead: Wheelset) -> Wheelsets {
         Wheelsets {
             lead,
             trailing: Vec::new(),
