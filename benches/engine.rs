@@ -6,8 +6,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
-use wheelflat::params::Scenario;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 use wheelflat::wheel::{FlatSpec, WheelProfile};
 
 /// Simulated time per benchmark iteration of the scaling and FMU groups (s).
@@ -102,7 +101,7 @@ fn fmu_step(c: &mut Criterion) {
     use std::ffi::CString;
     use wheelflat::fmu::ffi::*;
     use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
-    use wheelflat::params::VehicleSpec;
+    use wheelflat::sim::VehicleSpec;
 
     let mut g = c.benchmark_group("track_contact_per_0.1s");
     g.sample_size(10);

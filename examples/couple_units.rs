@@ -7,9 +7,7 @@
 //!
 //! `cargo run --release --example couple_units [steps_per_exchange]`
 
-use wheelflat::cosim::{VehicleUnit, VehicleUnitParams};
-use wheelflat::params::{Scenario, VehicleSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, VehicleSpec, VehicleUnit, VehicleUnitParams};
 
 fn main() -> Result<(), wheelflat::Error> {
     let per_exchange: u64 = std::env::args()

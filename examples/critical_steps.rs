@@ -1,8 +1,8 @@
 //! Prints the computed critical time step for the table 4.1 track at n = 1..5, 10
 //! (compare with the seed's table 4.2).
 fn main() {
-    let s = wheelflat::params::Scenario::table_4_1();
-    let wheelflat::params::TrackSpec::Discrete(mut t) = s.track else {
+    let s = wheelflat::sim::Scenario::table_4_1();
+    let wheelflat::sim::TrackSpec::Discrete(mut t) = s.track else {
         unreachable!()
     };
     for n in [1usize, 2, 3, 4, 5, 8, 10] {

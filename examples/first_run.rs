@@ -5,8 +5,7 @@
 //!
 //! `cargo run --release --example first_run`
 
-use wheelflat::params::Scenario;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 
 fn main() -> Result<(), wheelflat::Error> {
     let scenario = Scenario::table_4_4_flat();

@@ -2,8 +2,7 @@
 //! (table 4.4, 70 km/h, 100 mm x 1.5 mm haversine flat on the left wheel, 30 spans):
 //! n = 1, 2, 3, 4, 6, 8 nodes per span, each at dt = 0.5 dt_c and dt = 0.25 dt_c, plus
 //! the seed's own grid (n = 2, dt = 45 us). Prints a markdown table.
-use wheelflat::params::Scenario;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 
 fn peak(n: usize, dt: f64) -> (f64, f64, f64) {
     let mut s = Scenario::table_4_4_flat();
@@ -39,7 +38,7 @@ fn main() {
     for n in ns {
         let mut s = Scenario::table_4_4_flat();
         s.set_nodes_per_span(n);
-        let wheelflat::params::TrackSpec::Discrete(t) = s.track else {
+        let wheelflat::sim::TrackSpec::Discrete(t) = s.track else {
             unreachable!()
         };
         let dtc = t.critical_time_step().0;

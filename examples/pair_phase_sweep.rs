@@ -4,8 +4,7 @@
 //! run with the left flat alone. Prints the peak impact force (either wheel) per
 //! speed and grid, the worst phase, and the single-flat peak.
 //! `cargo run --release --example pair_phase_sweep`
-use wheelflat::params::{Scenario, TrackSpec, kmh};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec, kmh};
 use wheelflat::wheel::FlatSpec;
 
 fn peak(s: &Scenario) -> f64 {

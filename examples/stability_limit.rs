@@ -19,8 +19,7 @@
 //! `cargo run --release --example stability_limit` (about 30 s).
 use nalgebra::SymmetricEigen;
 use wheelflat::contact::ContactLaw;
-use wheelflat::params::{Scenario, TrackSpec, VehicleSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec, VehicleSpec};
 use wheelflat::track::{Track, TrackParams, perturbation_growth};
 use wheelflat::wheel::{FlatSpec, WheelProfile};
 

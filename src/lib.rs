@@ -7,20 +7,18 @@
 //!
 //! Modules, bottom up: [`wheel`] (wheel radius with flats), [`contact`] (normal
 //! contact laws), [`track`] (rails, pads, sleepers, ballast), [`vehicle`] (roll-plane
-//! vehicle and the alternative loads), [`solver`] (the coupled time stepping),
-//! [`params`] (the seed's parameter sets).
+//! vehicle and the alternative loads), [`sim`] (the thesis' parameter sets, the coupled
+//! time stepping and the co-simulation units).
 
 // Index loops over the two wheels/rails mirror the equations' subscripts.
 #![allow(clippy::needless_range_loop)]
 
 pub mod contact;
-pub mod cosim;
 pub mod error;
 pub mod fmu;
 pub mod limits;
 pub mod numerics;
-pub mod params;
-pub mod solver;
+pub mod sim;
 pub mod track;
 pub mod vehicle;
 pub mod wheel;

@@ -170,7 +170,7 @@ pub const MAX_VEHICLE_STEPS_PER_CALL: f64 = 2e7;
 pub const HEALTH_CHECK_INTERVAL: u64 = 256;
 /// RollPlaneVehicle carries a communication step shorter than this fraction of its
 /// step over to the next call rather than stepping it (see
-/// [`crate::cosim::VehicleUnit::advance`]).
+/// [`crate::sim::VehicleUnit::advance`]).
 pub const MIN_STEP_FRACTION: f64 = 1e-3;
 /// `solver.dt`, when given, must be at least this fraction of the critical step: a
 /// smaller step resolves nothing more and only multiplies the work.
@@ -179,7 +179,7 @@ pub const MIN_DT_FRACTION: f64 = 1e-3;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::{Scenario, TrackSpec, VehicleSpec};
+    use crate::sim::{Scenario, TrackSpec, VehicleSpec};
 
     #[test]
     fn every_seed_parameter_set_is_inside_the_ranges() {

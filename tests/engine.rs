@@ -3,8 +3,7 @@
 
 use wheelflat::Error;
 use wheelflat::contact::ContactModel;
-use wheelflat::params::{Scenario, TrackSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec};
 use wheelflat::wheel::FlatSpec;
 
 fn seed_grid(mut s: Scenario) -> Scenario {

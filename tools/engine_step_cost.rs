@@ -6,8 +6,7 @@
 
 use std::hint::black_box;
 use std::time::Instant;
-use wheelflat::params::Scenario;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 
 fn main() {
     let secs: f64 = std::env::args()

@@ -7,8 +7,7 @@
 
 use std::hint::black_box;
 use std::time::Instant;
-use wheelflat::params::Scenario;
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation};
 use wheelflat::wheel::WheelProfile;
 
 fn main() {

@@ -8,8 +8,7 @@ use std::hint::black_box;
 use std::time::Instant;
 use wheelflat::fmu::ffi::*;
 use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
-use wheelflat::params::{Scenario, VehicleSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, VehicleSpec};
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());

@@ -5,8 +5,7 @@
 //! `cargo run --release --example profile_step`
 use std::hint::black_box;
 use std::time::Instant;
-use wheelflat::params::{Scenario, TrackSpec};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, TrackSpec};
 use wheelflat::track::{PointLoad, SimdLevel, Track};
 
 fn main() {

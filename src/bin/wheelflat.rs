@@ -11,8 +11,7 @@ use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 use wheelflat::contact::ContactModel;
-use wheelflat::params::{Scenario, kmh};
-use wheelflat::solver::Simulation;
+use wheelflat::sim::{Scenario, Simulation, kmh};
 use wheelflat::wheel::{FlatShape, FlatSpec};
 
 const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \

@@ -6,7 +6,7 @@
 /// time.
 pub const LANES: usize = 8;
 
-/// Vector instructions the track stepper's loops (and [`crate::solver::Simulation`]'s
+/// Vector instructions the track stepper's loops (and [`crate::sim::Simulation`]'s
 /// coupled step) run with. The level is detected once when a track is built
 /// ([`SimdLevel::detect`]); [`crate::track::Track::set_simd`] picks another (for benchmarks and for
 /// checking that the levels agree). Ordered narrowest first.

@@ -5,8 +5,8 @@ use nalgebra::{DMatrix, SymmetricEigen, Vector6};
 
 /// Table 4.4 vehicle, from the preset.
 fn table_4_4() -> RollPlaneParams {
-    match crate::params::Scenario::table_4_4().vehicle {
-        crate::params::VehicleSpec::RollPlane(p) => p,
+    match crate::sim::Scenario::table_4_4().vehicle {
+        crate::sim::VehicleSpec::RollPlane(p) => p,
         _ => unreachable!("table 4.4 has the roll-plane vehicle"),
     }
 }

@@ -52,7 +52,7 @@ impl crate::fmu::Instance {
     }
 
     /// The scenario the variables of a track-carrying FMU describe.
-    pub fn scenario(&self) -> crate::params::Scenario {
+    pub fn scenario(&self) -> crate::sim::Scenario {
         scenario(self.kind(), self.values())
     }
 }

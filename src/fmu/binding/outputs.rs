@@ -3,9 +3,9 @@
 use super::FmuModel;
 use super::unit::Engine;
 use crate::contact::ContactState;
-use crate::cosim::VehicleUnit;
 use crate::fmu::vars::{QUANTITIES, Quantity};
-use crate::solver::{Sample, Simulation, VehicleState};
+use crate::sim::VehicleUnit;
+use crate::sim::{Sample, Simulation, VehicleState};
 
 /// Values computed when the model is built, published as calculated parameters.
 #[derive(Debug, Clone, Copy, Default)]

@@ -3,9 +3,9 @@
 
 use super::Kind;
 use crate::contact::ContactModel;
-use crate::cosim::VehicleUnitParams;
 use crate::fmu::vars::{FLAT_VRS, enums, vr};
-use crate::params::{Scenario, TrackSpec, VehicleSpec};
+use crate::sim::VehicleUnitParams;
+use crate::sim::{Scenario, TrackSpec, VehicleSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
 use crate::wheel::{FlatShape, FlatSpec};

@@ -5,15 +5,11 @@
 use super::Kind;
 use super::outputs::Published;
 use super::parameters::{scenario, vehicle_unit_params};
-use crate::cosim::VehicleUnit;
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
 use crate::fmu::vars::{FmuTable, VarSpec, vr};
-use crate::limits::{
-    FORCE_LIMIT_FACTOR, MAX_NODE_STEPS_PER_CALL, MAX_VEHICLE_STEPS_PER_CALL, force_limit, within,
-};
-use crate::params::TrackSpec;
-use crate::solver::{Sample, Simulation};
+use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
+use crate::sim::{Sample, Simulation, TrackSpec, VehicleUnit};
 
 /// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
 /// end's reflections raise the forces (the default start position, 1.37 m, is two
@@ -58,49 +54,6 @@ impl FmuModel {
         match &self.engine {
             Engine::Vehicle(u) => Some(u),
             Engine::Sim(_) => None,
-        }
-    }
-
-    /// Steps to take to the model time `end` (s): to the grid point nearest `end`
-    /// (track), or the vehicle's count of equal substeps; and the time the vehicle
-    /// is to advance by.
-    fn steps_to(&self, end: f64, clock: f64) -> (f64, f64) {
-        match &self.engine {
-            Engine::Sim(sim) => {
-                let target = (end / sim.dt()).round().max(0.0);
-                ((target - sim.steps() as f64).max(0.0), 0.0)
-            }
-            Engine::Vehicle(u) => {
-                let h = end - (u.time() + u.carried());
-                (u.steps_for(h, clock), h)
-            }
-        }
-    }
-    /// Why `n` steps are more than one call may do: at most
-    /// [`MAX_NODE_STEPS_PER_CALL`] rail-node updates (track) or
-    /// [`MAX_VEHICLE_STEPS_PER_CALL`] steps (vehicle).
-    fn work_refusal(&self, n: f64) -> Option<String> {
-        match &self.engine {
-            Engine::Sim(sim) => {
-                let cost = n * sim.rail_nodes() as f64;
-                (cost > MAX_NODE_STEPS_PER_CALL).then(|| {
-                    format!(
-                        "{n} steps of solver.step = {} s on {} rail nodes, {} node updates; the \
-                         most one call may do is {MAX_NODE_STEPS_PER_CALL:e} (about a second on the \
-                         default track)",
-                        sim.dt(),
-                        sim.rail_nodes(),
-                        num(cost)
-                    )
-                })
-            }
-            Engine::Vehicle(u) => (n > MAX_VEHICLE_STEPS_PER_CALL).then(|| {
-                format!(
-                    "{n} steps of solver.step = {} s; the most one call may do is \
-                     {MAX_VEHICLE_STEPS_PER_CALL:e} (about two seconds)",
-                    u.dt_base()
-                )
-            }),
         }
     }
 }
@@ -239,25 +192,25 @@ impl Model for FmuModel {
     /// steps, the internal step never changes (the explicit scheme is not stable under
     /// every sequence of step changes near its limit), and the model time never drifts
     /// from the master's by more than half a step. RollPlaneVehicle cuts the step into
-    /// equal steps (see [`VehicleUnit::advance`]). CoupledSystem has no inputs: the
+    /// equal steps (see [`VehicleUnit::advance`]); both units refuse more work than one call
+    /// may do before anything moves ([`Simulation::plan_to`], [`VehicleUnit::plan_to`]). CoupledSystem has no inputs: the
     /// sample at the end of the step is final, so a value beyond the health bounds
     /// there fails this step.
     fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), StepError> {
-        let (n, h) = self.steps_to(end, clock);
-        if let Some(w) = self.work_refusal(n) {
-            return Err(StepError::TooMuchWork(w));
-        }
-        Ok(match &mut self.engine {
+        match &mut self.engine {
             Engine::Sim(sim) => {
-                sim.advance_steps(n as u64)?;
-                match self.kind {
-                    Kind::CoupledSystem => sim.check_sample(),
-                    _ => Ok(()),
+                let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                sim.advance_to(plan)?;
+                if self.kind == Kind::CoupledSystem {
+                    sim.check_sample()?;
                 }
             }
-            Engine::Vehicle(u) if h > 0.0 => u.advance(h, clock),
-            Engine::Vehicle(_) => Ok(()),
-        }?)
+            Engine::Vehicle(u) => {
+                let plan = u.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                u.advance_to(plan)?;
+            }
+        }
+        Ok(())
     }
 
     fn step_fault(e: &Error) -> StepFault {

@@ -244,7 +244,7 @@ fn every_output_of_every_fmu_reads_its_quantity_from_the_engine() {
     assert_eq!(real(&mut i, vr::RAIL_RIGHT_Z), s.rail_z[1]);
     assert_eq!(real(&mut i, vr::WHEEL_RIGHT_Z), s.wheel_z[1]);
     let (d, bearing) = match simulation(&i).vehicle() {
-        crate::solver::VehicleState::RollPlane(v) => (*v.displacements(), v.bearing_forces()),
+        crate::sim::VehicleState::RollPlane(v) => (*v.displacements(), v.bearing_forces()),
         _ => unreachable!("CoupledSystem carries the roll-plane vehicle"),
     };
     assert_eq!(real(&mut i, vr::SIDEFRAME_RIGHT_Z), d[3]);

@@ -8,8 +8,8 @@ mod machine;
 pub(super) use crate::fmu::fmi2::{ALL, MAGIC};
 pub(super) use crate::fmu::vars::{self, Causality, vr};
 pub(super) use crate::fmu::*;
-pub(super) use crate::params::{Scenario, VehicleSpec};
-pub(super) use crate::solver::Simulation;
+pub(super) use crate::sim::Simulation;
+pub(super) use crate::sim::{Scenario, VehicleSpec};
 pub(super) use std::sync::{Arc, Mutex};
 
 pub(super) fn instance(kind: Kind) -> (Instance, Arc<Mutex<Vec<String>>>) {

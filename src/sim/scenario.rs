@@ -1,4 +1,4 @@
-//! The seed's parameter sets as ready-made scenarios, with its misprints handled as
+//! The thesis' parameter sets as ready-made scenarios, with its misprints handled as
 //! `MODEL.md` says:
 //!
 //! * Table 5.1 car body mass reads 1470.2 kg; 14702 kg gives the 82 kN static wheel
@@ -34,7 +34,7 @@ pub enum VehicleSpec {
     ConstantLoad([f64; 2]),
     /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
     /// displacements and the axle angle are inputs
-    /// ([`crate::solver::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`
+    /// ([`crate::sim::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`
     /// (N) is the load the external vehicle puts on each wheel at rest, used for the
     /// static start and for calibrating `K_w`.
     External {
@@ -72,7 +72,7 @@ pub struct Scenario {
 }
 
 /// Grid nodes per sleeper span used by default: the converged choice of the grid
-/// study in `docs/VALIDATION.md` (the seed used 2).
+/// study in `docs/VALIDATION.md` (the thesis used 2).
 pub const DEFAULT_NODES_PER_SPAN: usize = 8;
 /// Default time step as a fraction of the critical step.
 pub const DEFAULT_DT_FRACTION: f64 = 0.9;
@@ -82,7 +82,8 @@ pub fn kmh(v: f64) -> f64 {
     v / 3.6
 }
 
-fn seed_track_4(spans: usize) -> TrackParams {
+/// The track of tables 4.1 and 4.4 with `spans` sleeper spans at the default grid.
+fn table_4_track(spans: usize) -> TrackParams {
     TrackParams {
         spans,
         nodes_per_span: DEFAULT_NODES_PER_SPAN,
@@ -106,7 +107,7 @@ impl Scenario {
     pub fn table_4_4() -> Scenario {
         Scenario {
             name: "table 4.4".into(),
-            track: TrackSpec::Discrete(seed_track_4(30)),
+            track: TrackSpec::Discrete(table_4_track(30)),
             vehicle: VehicleSpec::RollPlane(RollPlaneParams {
                 carbody_mass: 20150.0,
                 bolster_mass: 232.5,
@@ -150,7 +151,7 @@ impl Scenario {
     pub fn table_4_1() -> Scenario {
         let mut s = Scenario::table_4_4();
         s.name = "table 4.1, constant 100 kN per rail".into();
-        s.track = TrackSpec::Discrete(seed_track_4(20));
+        s.track = TrackSpec::Discrete(table_4_track(20));
         s.vehicle = VehicleSpec::ConstantLoad([100e3, 100e3]);
         s.kw = 5.3361e10;
         s.speed = kmh(50.0);

@@ -1,0 +1,157 @@
+//! The health checks of a run: every state and every sample against the bounds of
+//! [`crate::limits`] that no physical run passes, with the likely cause in words.
+
+use super::simulation::{Simulation, TrackState, VehicleState};
+use super::wheelset::Sample;
+use crate::error::{Error, Result, num};
+use crate::limits::{DISPLACEMENT_LIMIT, within};
+
+impl Simulation {
+    /// Checks every state of the track and the vehicle against the health bounds of
+    /// [`crate::limits`]: rail and sleeper displacements within
+    /// [`DISPLACEMENT_LIMIT`], vehicle bodies within
+    /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`], all finite. Run every
+    /// [`crate::limits::HEALTH_CHECK_INTERVAL`] steps and after the static solve.
+    ///
+    /// Errors: [`Error::Diverged`] naming the first value beyond its bound.
+    pub fn check_states(&self) -> Result<()> {
+        if let TrackState::Discrete(t) = &self.track {
+            let m = t.max_abs_displacement();
+            if !within(m, DISPLACEMENT_LIMIT) {
+                return Err(Error::Diverged {
+                    what: "largest rail or sleeper displacement (m)".into(),
+                    value: m,
+                    limit: DISPLACEMENT_LIMIT,
+                    time: self.time(),
+                    cause: self.likely_cause(),
+                });
+            }
+        }
+        if let VehicleState::RollPlane(v) = &self.vehicle
+            && let Some((what, value, limit)) = v.beyond_bounds()
+        {
+            return Err(Error::Diverged {
+                what: format!("vehicle {what}"),
+                value,
+                limit,
+                time: self.time(),
+                cause: self.likely_cause(),
+            });
+        }
+        Ok(())
+    }
+
+    /// [`Simulation::check_states`], and the sample at the current time: wheel and rail
+    /// under the wheel within [`DISPLACEMENT_LIMIT`], contact forces within the force
+    /// limit, the force extremes finite.
+    pub fn check_health(&self) -> Result<()> {
+        self.check_states()?;
+        self.check_sample()
+    }
+
+    /// The sample part of [`Simulation::check_health`].
+    pub fn check_sample(&self) -> Result<()> {
+        // Cheap: the sample is cached and used by the next step.
+        match self.sample_beyond_bounds(&self.sample()) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// The error for a wheel or rail displacement under the wheel of the latest sample
+    /// beyond the bound.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn displacement_diverged(&self) -> Error {
+        // The caller found one of the four displacements beyond the bound, and they
+        // lead the list; the fallback is never taken.
+        let latest = &self.wheelsets.lead().latest;
+        self.sample_beyond_bounds(latest)
+            .unwrap_or_else(|| Error::NonFinite {
+                what: "wheel or rail under the wheel".into(),
+                time: latest.time,
+            })
+    }
+
+    /// The first value of the leading wheelset's sample `s` (or of its force extremes)
+    /// beyond the health bounds, as the error that names it: wheel and rail under the
+    /// wheel within [`DISPLACEMENT_LIMIT`], contact forces and their extremes within the
+    /// force limit.
+    fn sample_beyond_bounds(&self, s: &Sample) -> Option<Error> {
+        let lim = self.force_limit;
+        let (max, min) = (self.max_force(), self.min_force());
+        let values = [
+            ("wheel.left.z (m)", s.wheel_z[0], DISPLACEMENT_LIMIT),
+            ("wheel.right.z (m)", s.wheel_z[1], DISPLACEMENT_LIMIT),
+            (
+                "rail.left.z under the wheel (m)",
+                s.rail_z[0],
+                DISPLACEMENT_LIMIT,
+            ),
+            (
+                "rail.right.z under the wheel (m)",
+                s.rail_z[1],
+                DISPLACEMENT_LIMIT,
+            ),
+            ("contact.left.force (N)", s.contact[0].force, lim),
+            ("contact.right.force (N)", s.contact[1].force, lim),
+            ("contact.left.max_force (N)", max[0].max(0.0), lim),
+            ("contact.right.max_force (N)", max[1].max(0.0), lim),
+            ("contact.left.min_force (N)", min[0].min(0.0), lim),
+            ("contact.right.min_force (N)", min[1].min(0.0), lim),
+        ];
+        let (what, value, limit) = values.into_iter().find(|(_, x, l)| !within(*x, *l))?;
+        Some(Error::Diverged {
+            what: what.into(),
+            value,
+            limit,
+            time: s.time,
+            cause: self.likely_cause(),
+        })
+    }
+
+    /// The error for a contact force `p` `[left, right]` (N) at `time` (s) beyond
+    /// [`crate::limits::force_limit`].
+    #[cold]
+    #[inline(never)]
+    pub(super) fn force_diverged(&self, p: [f64; 2], time: f64) -> Error {
+        let i = usize::from(within(p[0], self.force_limit));
+        let side = ["left", "right"][i];
+        Error::Diverged {
+            what: format!("contact.{side}.force (N)"),
+            value: p[i],
+            limit: self.force_limit,
+            time,
+            cause: format!(
+                "{} times the static wheel load {} N; {}",
+                crate::limits::FORCE_LIMIT_FACTOR,
+                num(self.static_load[0].max(self.static_load[1])),
+                self.likely_cause()
+            ),
+        }
+    }
+
+    /// What most likely drove a value beyond the health bounds, in words.
+    fn likely_cause(&self) -> String {
+        let dt = self.dt();
+        let step = match &self.track {
+            TrackState::Discrete(t) => format!(
+                "solver.step = {} s is {:.3} of the critical step {} s, so the explicit \
+                 scheme should be stable: check parameters far from a railway",
+                num(dt),
+                dt / t.dt_critical(),
+                num(t.dt_critical())
+            ),
+            TrackState::Lumped(_) => "the explicit scheme diverged".into(),
+        };
+        match &self.vehicle {
+            VehicleState::External { wheel_z, .. } => format!(
+                "likely the wheel inputs (wheel.left.z = {} m, wheel.right.z = {} m) press \
+                 the wheel into the rail far beyond a running wheel's overlap; else {step}",
+                num(wheel_z[0]),
+                num(wheel_z[1])
+            ),
+            _ => step,
+        }
+    }
+}

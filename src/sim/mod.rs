@@ -1,0 +1,24 @@
+//! The coupled simulation: scenarios and the thesis' parameter sets, the monolithic
+//! vehicle-track-contact run with its list of wheelsets, and the two co-simulation
+//! units, which share one clock, one way of counting steps and one record of force
+//! extremes.
+
+mod clock;
+mod health;
+mod inputs;
+mod scenario;
+mod simulation;
+mod state;
+mod static_start;
+#[cfg(test)]
+mod tests;
+mod vehicle_unit;
+mod wheelset;
+
+pub use clock::StepPlan;
+pub use scenario::{
+    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, VehicleSpec, kmh,
+};
+pub use simulation::{CONTACT_STIFFNESS_MARGIN, Simulation, TrackState, VehicleState, default_dt};
+pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
+pub use wheelset::{Sample, Wheelset, Wheelsets};

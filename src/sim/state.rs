@@ -1,0 +1,124 @@
+//! The state vector of a simulation: everything that determines the continuation, so
+//! that a saved run continues bit for bit (FMU states).
+
+use super::clock::ForceExtremes;
+use super::simulation::{Simulation, TrackState, VehicleState};
+use crate::error::{Error, Result, num, out_of_range};
+use crate::limits::MIN_DT_FRACTION;
+
+/// Values of the clock at the head of a state vector: step (s), `t0` (s), steps since
+/// `t0`, steps since the start.
+const CLOCK: usize = 4;
+
+impl Simulation {
+    /// Everything that determines the continuation: the clock (step (s), `t0` (s),
+    /// steps since `t0`, steps since the start), the force extremes of every wheelset
+    /// (`[max left, max right, min left, min right]` (N)), the track's state, then the
+    /// vehicle's (the roll-plane vehicle's step and displacements, or the external
+    /// wheels' inputs: `z` `[left, right]` (m), the axle angle (rad) and the time (s)
+    /// it was given at). [`Simulation::set_state_vector`] restores it exactly.
+    ///
+    /// Errors: a lumped track or lumped wheels ([`Error::Unsupported`]); only the
+    /// discrete track with the roll-plane vehicle, constant loads or external wheels
+    /// has a state vector.
+    pub fn state_vector(&self) -> Result<Vec<f64>> {
+        let c = &self.clock;
+        let mut v = vec![c.dt, c.t0, c.k as f64, self.steps as f64];
+        for w in self.wheelsets.iter() {
+            v.extend(w.extremes.to_array());
+        }
+        match &self.track {
+            TrackState::Discrete(t) => v.extend(t.state_vector()),
+            TrackState::Lumped(_) => return Err(Self::no_state()),
+        }
+        v.extend(self.vehicle_state()?);
+        Ok(v)
+    }
+
+    /// The vehicle's part of [`Simulation::state_vector`].
+    fn vehicle_state(&self) -> Result<Vec<f64>> {
+        Ok(match &self.vehicle {
+            VehicleState::RollPlane(r) => r.state_vector(),
+            VehicleState::ConstantLoad(_) => Vec::new(),
+            VehicleState::External {
+                wheel_z,
+                rotation,
+                since,
+            } => vec![wheel_z[0], wheel_z[1], *rotation, *since],
+            VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
+        })
+    }
+
+    fn no_state() -> Error {
+        Error::Unsupported(
+            "state vector of a lumped model (only the discrete track with the roll-plane \
+             vehicle or constant loads has one)"
+                .into(),
+        )
+    }
+
+    /// Restores a state written by [`Simulation::state_vector`] of a simulation built
+    /// from the same scenario. Refused: a wrong length, a step outside what
+    /// [`Simulation::new`] accepts, a clock or step count that is not a whole number
+    /// below 2^53, and a state beyond the health bounds ([`Simulation::check_health`]),
+    /// which then stays in the simulation: rebuild it.
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if let (Some(&dt), TrackState::Discrete(_)) = (v.first(), &self.track) {
+            let c = self.critical_step;
+            if !(dt >= MIN_DT_FRACTION * c && dt <= c) {
+                return Err(out_of_range(
+                    "state: step",
+                    dt,
+                    format!("{} s <= dt <= {} s", num(MIN_DT_FRACTION * c), num(c)),
+                ));
+            }
+        }
+        let count = crate::limits::is_count;
+        if v.len() >= CLOCK && !(v[1].is_finite() && v[1] >= 0.0 && count(v[2]) && count(v[3])) {
+            return Err(out_of_range(
+                "state: clock",
+                v[1],
+                "t0 finite and >= 0 s, step counts whole numbers in [0, 2^53)",
+            ));
+        }
+        let nt = match &self.track {
+            TrackState::Discrete(t) => t.state_len(),
+            TrackState::Lumped(_) => return Err(Self::no_state()),
+        };
+        let nv = self.vehicle_state()?.len();
+        let head = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
+        if v.len() != head + nt + nv {
+            return Err(out_of_range(
+                "simulation state length",
+                v.len() as f64,
+                format!("{} values for this scenario", head + nt + nv),
+            ));
+        }
+        if let TrackState::Discrete(t) = &mut self.track {
+            t.set_state_vector(&v[head..head + nt])?;
+        }
+        let e = &v[head + nt..];
+        match &mut self.vehicle {
+            VehicleState::RollPlane(r) => r.set_state_vector(e)?,
+            VehicleState::External {
+                wheel_z,
+                rotation,
+                since,
+            } => {
+                *wheel_z = [e[0], e[1]];
+                *rotation = e[2];
+                *since = e[3];
+            }
+            _ => {}
+        }
+        let c = &mut self.clock;
+        (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);
+        self.steps = v[3] as u64;
+        let extremes = v[CLOCK..head].chunks_exact(ForceExtremes::LEN);
+        for (w, x) in self.wheelsets.iter_mut().zip(extremes) {
+            w.extremes = ForceExtremes::from_slice(x);
+        }
+        self.clear_cache();
+        self.check_health()
+    }
+}

@@ -1,0 +1,149 @@
+//! The static start: the run begins in the static equilibrium of the whole system,
+//! solved directly (the thesis starts the track at rest and waits about 0.2 s), and a
+//! contact or track too soft to carry the static wheel load is refused.
+
+use super::simulation::{Simulation, TrackState, VehicleState};
+use super::wheelset::wheel_loads;
+use crate::contact::{ContactLaw, ContactModel, kw_from_hertz};
+use crate::error::{Result, non_negative, num, out_of_range};
+use crate::limits::{MAX_STATIC_OVERLAP, MAX_STATIC_RAIL_DEFLECTION, within};
+use crate::sim::{Scenario, TrackSpec, VehicleSpec};
+use crate::wheel::WheelProfile;
+
+/// The static load on each wheel `[left, right]` (N) of the scenario's vehicle: the
+/// roll-plane vehicle's weight share (table 4.4: 107.6 kN), the lumped wheel's load, the
+/// constant loads or the external vehicle's static loads.
+///
+/// Errors: a constant or static load below 0 N.
+pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
+    Ok(match vehicle {
+        VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::LumpedWheels(p) => [p.load; 2],
+        VehicleSpec::ConstantLoad(p) => {
+            non_negative("load.left", p[0], "N")?;
+            non_negative("load.right", p[1], "N")?;
+            *p
+        }
+        VehicleSpec::External { static_load } => {
+            non_negative("static_load.left", static_load[0], "N")?;
+            non_negative("static_load.right", static_load[1], "N")?;
+            *static_load
+        }
+    })
+}
+
+/// The scenario's contact law: adaptive with its `K_w`, or with `K_w` calibrated from
+/// `C_H` and the static load `static_load[0]` (N) by (2.25, 2.26) when it is 0; or
+/// Hertz (1.3).
+///
+/// Errors: a law its constructor refuses; a contact so soft that the larger static
+/// load sinks a perfect wheel more than [`MAX_STATIC_OVERLAP`] into the rail (a wheel on
+/// a rail overlaps it by about 0.1 mm), named by `contact.Kw` when given, else
+/// `contact.CH`.
+pub(crate) fn contact_law(s: &Scenario, static_load: [f64; 2]) -> Result<ContactLaw> {
+    let law = match s.contact_model {
+        ContactModel::Adaptive => {
+            let kw = if s.kw > 0.0 {
+                s.kw
+            } else {
+                kw_from_hertz(s.hertz_coefficient, static_load[0].max(1.0), s.wheel_radius)?
+            };
+            ContactLaw::adaptive(kw)?
+        }
+        ContactModel::Hertz => ContactLaw::hertz(s.hertz_coefficient)?,
+    };
+    let load = static_load[0].max(static_load[1]);
+    let perfect = WheelProfile::perfect(s.wheel_radius)?;
+    let overlap = law.overlap_for_force(&perfect, 0.0, load);
+    if load > 0.0 && !within(overlap, MAX_STATIC_OVERLAP) {
+        let (name, value) = match (s.contact_model, s.kw > 0.0) {
+            (ContactModel::Adaptive, true) => ("contact.Kw", s.kw),
+            _ => ("contact.CH", s.hertz_coefficient),
+        };
+        return Err(out_of_range(
+            name,
+            value,
+            format!(
+                "a contact that carries the static wheel load {} N with an overlap of at \
+                 most {MAX_STATIC_OVERLAP} m (this one: {} m; wheel on rail: about 0.1 mm)",
+                num(load),
+                num(overlap)
+            ),
+        ));
+    }
+    Ok(law)
+}
+
+impl Simulation {
+    /// Static equilibrium of the whole system at the start position: static wheel
+    /// loads from the vehicle, track deflection under the loads of every wheelset
+    /// (direct solve), overlaps from the inverse contact law, then the vehicle resting
+    /// on those wheel heights.
+    pub(crate) fn set_static(&mut self) -> Result<()> {
+        self.clear_cache();
+        let x = self.scenario.start_position;
+        let p = self.static_load;
+        let w = self.wheelsets.lead();
+        let xw = w.position(x);
+        let zr = match &mut self.track {
+            TrackState::Discrete(t) => {
+                wheel_loads(x, &self.wheelsets, |_| p, &mut self.loads);
+                t.set_static(&self.loads)?;
+                [t.rail_z_at(0, xw), t.rail_z_at(1, xw)]
+            }
+            TrackState::Lumped(t) => {
+                t.set_static(p);
+                t.rail_z()
+            }
+        };
+        let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));
+        let zw = [zr[0] - delta[0], zr[1] - delta[1]];
+        match &mut self.vehicle {
+            VehicleState::RollPlane(v) => v.set_static(zw)?,
+            VehicleState::LumpedWheels(v) => v.set_static(zw),
+            VehicleState::ConstantLoad(_) => {}
+            VehicleState::External { wheel_z, .. } => *wheel_z = zw,
+        }
+        Ok(())
+    }
+
+    /// Refuses a discrete track that sinks more than [`MAX_STATIC_RAIL_DEFLECTION`]
+    /// under the static wheel loads (table 4.4: 1.3 mm), named by the support softest
+    /// against table 4.4's (pads 140 MN/m, ballast 40 MN/m); the message gives all that
+    /// carry the load.
+    pub(crate) fn check_static_sag(&self) -> Result<()> {
+        let (TrackSpec::Discrete(p), TrackState::Discrete(_)) = (&self.scenario.track, &self.track)
+        else {
+            return Ok(());
+        };
+        let z = self.rail_z();
+        let sag = z[0].abs().max(z[1].abs());
+        if within(sag, MAX_STATIC_RAIL_DEFLECTION) {
+            return Ok(());
+        }
+        let load = self.static_load[0].max(self.static_load[1]);
+        let (name, value) = if p.ballast_stiffness / 40e6 < p.pad_stiffness / 140e6 {
+            ("track.ballast.stiffness", p.ballast_stiffness)
+        } else {
+            ("track.pad.stiffness", p.pad_stiffness)
+        };
+        Err(out_of_range(
+            name,
+            value,
+            format!(
+                "a track that carries the static wheel load {} N with a rail deflection \
+                 of at most {MAX_STATIC_RAIL_DEFLECTION} m (this one: {} m with \
+                 track.pad.stiffness = {} N/m, track.ballast.stiffness = {} N/m, \
+                 track.rail.EI = {} N m^2, track.rail.kAG = {} N, track.sleeper_spacing \
+                 = {} m; table 4.4: 1.3 mm)",
+                num(load),
+                num(sag),
+                num(p.pad_stiffness),
+                num(p.ballast_stiffness),
+                num(p.rail.ei),
+                num(p.rail.kag),
+                num(p.sleeper_spacing)
+            ),
+        ))
+    }
+}

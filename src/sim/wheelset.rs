@@ -1,0 +1,229 @@
+//! The wheelsets of a simulation: each with its two wheels, its place behind the
+//! leading wheelset and its contact states, and the loads they put on the rails.
+
+use super::clock::ForceExtremes;
+use super::simulation::VehicleState;
+use crate::contact::{ContactLaw, ContactState};
+use crate::error::{Result, non_negative};
+use crate::track::PointLoad;
+use crate::wheel::{FlatSpec, WheelProfile};
+use std::cell::Cell;
+
+/// Everything reported at one instant for one wheelset.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Sample {
+    /// Time `t_j` (s).
+    pub time: f64,
+    /// Wheelset position along the track (m).
+    pub position: f64,
+    /// Axle rotation angle `gamma` (rad) (2.17).
+    pub rotation: f64,
+    /// Wheel-centre displacements `[left, right]` (m), up positive.
+    pub wheel_z: [f64; 2],
+    /// Rail displacements under the wheels `[left, right]` (m) (3.23).
+    pub rail_z: [f64; 2],
+    /// Contact states `[left, right]`: force, overlap (2.7), patch angles (2.22), length.
+    pub contact: [ContactState; 2],
+}
+
+/// One wheelset on the track: its left and right wheel (nominal radius `R_w` and
+/// flats, 2.9-2.21), its distance `d_k >= 0` (m) behind the leading wheelset (it runs at
+/// `x_k = x_1 - d_k`), its contact states and the extremes of its contact forces.
+#[derive(Debug, Clone)]
+pub struct Wheelset {
+    wheels: [WheelProfile; 2],
+    offset: f64,
+    pub(crate) extremes: ForceExtremes,
+    // The sample of the latest step, contact states included, built here in place by
+    // `Simulation::step` (a sample built in a temporary and copied at once stalled the
+    // copy's wide loads on the narrow stores that had just built it).
+    pub(crate) latest: Sample,
+    // The sample at the current time and inputs, once computed (a co-simulation master
+    // reads the outputs and then steps: the contact is evaluated once).
+    pub(crate) cached: Cell<Option<Sample>>,
+}
+
+impl Wheelset {
+    /// A wheelset `offset` (m) behind the leading one whose wheels have the nominal
+    /// radius `radius` (m) and the flats `flats` `[left, right]`.
+    ///
+    /// Errors: `offset` negative or not finite; a radius or flat that
+    /// [`WheelProfile::new`] refuses (named `flat.left` or `flat.right`).
+    pub fn new(radius: f64, flats: &[Vec<FlatSpec>; 2], offset: f64) -> Result<Wheelset> {
+        non_negative("wheelset.offset", offset, "m")?;
+        Ok(Wheelset {
+            wheels: [
+                WheelProfile::new(radius, &flats[0], "flat.left")?,
+                WheelProfile::new(radius, &flats[1], "flat.right")?,
+            ],
+            offset,
+            extremes: ForceExtremes::NONE,
+            latest: Sample::default(),
+            cached: Cell::new(None),
+        })
+    }
+
+    /// The wheels `[left, right]`.
+    pub fn wheels(&self) -> &[WheelProfile; 2] {
+        &self.wheels
+    }
+    /// Distance `d_k` behind the leading wheelset (m).
+    pub fn offset(&self) -> f64 {
+        self.offset
+    }
+    /// Position `x_1 - d_k` (m) when the leading wheelset is at `x` (m).
+    #[inline(always)]
+    pub fn position(&self, x: f64) -> f64 {
+        x - self.offset
+    }
+    /// Largest contact force per wheel `[left, right]` that has driven a step (N);
+    /// `f64::MIN` before the first step.
+    pub fn max_force(&self) -> [f64; 2] {
+        self.extremes.max
+    }
+    /// Smallest contact force per wheel `[left, right]` that has driven a step (N);
+    /// `f64::MAX` before the first step.
+    pub fn min_force(&self) -> [f64; 2] {
+        self.extremes.min
+    }
+    /// The wheels and the latest sample, to build the sample in place.
+    #[inline(always)]
+    pub(crate) fn parts_mut(&mut self) -> (&[WheelProfile; 2], &mut Sample) {
+        (&self.wheels, &mut self.latest)
+    }
+    /// The contact forces `[left, right]` (N) of the latest step.
+    #[inline(always)]
+    pub(crate) fn forces(&self) -> [f64; 2] {
+        let c = &self.latest.contact;
+        [c[0].force, c[1].force]
+    }
+}
+
+/// The wheelsets on the track, the leading one first (`d_1 = 0`): a list that is never
+/// empty, and the one place the wheels of a simulation live.
+#[derive(Debug, Clone)]
+pub struct Wheelsets {
+    // The leading wheelset is kept apart from the vector of the others: the step reaches
+    // it without a bounds check or a pointer chase (a plain `Vec` cost 2 % of the step).
+    lead: Wheelset,
+    trailing: Vec<Wheelset>,
+}
+
+impl Wheelsets {
+    /// The list of one wheelset, `lead`.
+    pub(crate) fn new(lead: Wheelset) -> Wheelsets {
+        Wheelsets {
+            lead,
+            trailing: Vec::new(),
+        }
+    }
+    /// Number of wheelsets (at least 1).
+    pub fn len(&self) -> usize {
+        1 + self.trailing.len()
+    }
+    /// Never: there is at least the leading wheelset.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+    /// The leading wheelset, `d_1 = 0`.
+    #[inline(always)]
+    pub fn lead(&self) -> &Wheelset {
+        &self.lead
+    }
+    #[inline(always)]
+    pub(crate) fn lead_mut(&mut self) -> &mut Wheelset {
+        &mut self.lead
+    }
+    /// The wheelsets, the leading one first.
+    pub fn iter(&self) -> impl Iterator<Item = &Wheelset> {
+        std::iter::once(&self.lead).chain(&self.trailing)
+    }
+    /// Forgets every cached sample.
+    #[inline(always)]
+    pub(crate) fn clear_cache(&self) {
+        self.lead.cached.set(None);
+        for w in &self.trailing {
+            w.cached.set(None);
+        }
+    }
+    /// The wheelsets, the leading one first.
+    pub(crate) fn iter_mut(&mut self) -> impl Iterator<Item = &mut Wheelset> {
+        std::iter::once(&mut self.lead).chain(&mut self.trailing)
+    }
+}
+
+/// The loads of every wheelset on the rails, written into `loads`, two per wheelset
+/// (left rail, then right) in the order of the list: wheelset k, at `x - d_k` (m) when
+/// the leading one is at `x`, pushes each rail down with its wheel's force of
+/// `p(wheelset)` `[left, right]` (N): the contact forces `P` (3.22 shares each between
+/// the two nodes around it), or the static loads. `loads` holds two per wheelset.
+#[inline(always)]
+pub(crate) fn wheel_loads(
+    x: f64,
+    wheelsets: &Wheelsets,
+    p: impl Fn(&Wheelset) -> [f64; 2],
+    loads: &mut [PointLoad],
+) {
+    let place = |w: &Wheelset, pair: &mut [PointLoad]| {
+        let (position, force) = (w.position(x), p(w));
+        for (rail, load) in pair.iter_mut().enumerate() {
+            *load = PointLoad {
+                rail,
+                position,
+                force: force[rail],
+            };
+        }
+    };
+    let (lead, rest) = loads.split_at_mut(2);
+    place(&wheelsets.lead, lead);
+    if !wheelsets.trailing.is_empty() {
+        for (w, pair) in wheelsets.trailing.iter().zip(rest.chunks_exact_mut(2)) {
+            place(w, pair);
+        }
+    }
+}
+
+/// The contact states of sample `s` of a wheelset with wheels `wheels`, whose head
+/// (time, rotation, wheel and rail displacements) is set, written in place: the
+/// contact law at the overlaps `z_rail - z_wheel` (2.7) with the axle at the sample's
+/// rotation, or the constant loads.
+#[inline(always)]
+pub(crate) fn contact_states(
+    vehicle: &VehicleState,
+    law: &ContactLaw,
+    wheels: &[WheelProfile; 2],
+    s: &mut Sample,
+) {
+    match vehicle {
+        VehicleState::ConstantLoad(p) => {
+            for (c, &force) in s.contact.iter_mut().zip(p) {
+                *c = ContactState {
+                    force,
+                    intervals: 1,
+                    ..Default::default()
+                };
+            }
+        }
+        _ => {
+            let gamma = wrap_turns(s.rotation);
+            for i in 0..2 {
+                let overlap = s.rail_z[i] - s.wheel_z[i];
+                law.evaluate_into(&wheels[i], gamma, overlap, &mut s.contact[i]);
+            }
+        }
+    }
+}
+
+/// Angle `a` (rad) wrapped into [0, 2 pi).
+#[inline]
+fn wrap_turns(a: f64) -> f64 {
+    use std::f64::consts::TAU;
+    if !a.is_finite() || a.abs() > 1e15 {
+        return a.rem_euclid(TAU);
+    }
+    // The whole number of turns is taken off by truncation rather than `rem_euclid`
+    // (a libm `fmod` call): the result differs by a rounding of the turns removed,
+    // which is below the rounding already in the unwrapped angle.
+    let r = a - (a * (1.0 / TAU)) as i64 as f64 * TAU;
+    if r < 0.0 { r + TAU } else { r }
+}
