@@ -1,0 +1,72 @@
+//! Bit-exact hashes of every sample of the three reference runs (the check that a
+//! restructure or a speed change leaves every result unchanged): the seed grid through
+//! 0.8 s, the converged defaults through 0.3 s, and three flats (two haversine on the
+//! left wheel, a chord on the right) through 0.3 s. Each line is an FNV-1a hash over the
+//! bits of every field of every sample (time, position, rotation, wheel and rail
+//! displacements, every field of both contact states).
+//!
+//! `cargo run --release --example sample_hash`
+
+use wheelflat::sim::{Sample, Scenario, Simulation};
+use wheelflat::wheel::FlatSpec;
+
+/// FNV-1a over the bits of `f64`s.
+struct Fnv(u64);
+
+impl Fnv {
+    fn add(&mut self, x: f64) {
+        for b in x.to_bits().to_le_bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    fn sample(&mut self, s: &Sample) {
+        for x in [s.time, s.position, s.rotation] {
+            self.add(x);
+        }
+        for i in 0..2 {
+            let c = &s.contact[i];
+            for x in [
+                s.wheel_z[i],
+                s.rail_z[i],
+                c.force,
+                c.overlap,
+                c.front_angle,
+                c.rear_angle,
+                c.length,
+                c.intervals as f64,
+            ] {
+                self.add(x);
+            }
+        }
+    }
+}
+
+fn run(name: &str, s: &Scenario, duration: f64) {
+    let mut sim = Simulation::new(s).unwrap();
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    h.sample(&sim.sample());
+    let n = (duration / sim.dt()).round() as u64;
+    for _ in 0..n {
+        h.sample(&sim.step().unwrap());
+    }
+    println!("{name}: {n} steps, sample hash {:016x}", h.0);
+}
+
+fn main() {
+    let mut seed = Scenario::table_4_4_flat();
+    seed.set_nodes_per_span(2);
+    seed.dt = 45e-6;
+    run("seed grid (n = 2, dt = 45 us), 0.8 s", &seed, 0.8);
+    let defaults = Scenario::table_4_4_flat();
+    run("converged defaults, 0.3 s", &defaults, 0.3);
+    let mut flats = Scenario::table_4_4_flat();
+    // As the runner's `--flat left:100:1.5:90 --flat left:60:0.8:250
+    // --flat right:80:0:120:chord` builds them (mm and degrees).
+    let (mm, deg) = (|x: f64| x * 1e-3, |a: f64| a.to_radians());
+    flats.flats[0].push(FlatSpec::haversine(mm(100.0), mm(1.5), deg(90.0)));
+    flats.flats[0].push(FlatSpec::haversine(mm(60.0), mm(0.8), deg(250.0)));
+    flats.flats[1].push(FlatSpec::chord(mm(80.0), deg(120.0)));
+    run("three more flats, 0.3 s", &flats, 0.3);
+}
