@@ -5,7 +5,8 @@
 //! bits of every field of every sample (time, position, rotation, wheel and rail
 //! displacements, every field of both contact states).
 //!
-//! `cargo run --release --example sample_hash`
+//! `cargo run --release --example sample_hash [seed|defaults|flats]` (all three
+//! without an argument; one of them for counting its instructions under callgrind).
 
 use wheelflat::sim::{Sample, Scenario, Simulation};
 use wheelflat::wheel::FlatSpec;
@@ -55,12 +56,18 @@ fn run(name: &str, s: &Scenario, duration: f64) {
 }
 
 fn main() {
+    let only = std::env::args().nth(1);
+    let run = |key: &str, name: &str, s: &Scenario, duration: f64| {
+        if only.as_deref().is_none_or(|o| o == key) {
+            run(name, s, duration);
+        }
+    };
     let mut seed = Scenario::table_4_4_flat();
     seed.set_nodes_per_span(2);
     seed.dt = 45e-6;
-    run("seed grid (n = 2, dt = 45 us), 0.8 s", &seed, 0.8);
+    run("seed", "seed grid (n = 2, dt = 45 us), 0.8 s", &seed, 0.8);
     let defaults = Scenario::table_4_4_flat();
-    run("converged defaults, 0.3 s", &defaults, 0.3);
+    run("defaults", "converged defaults, 0.3 s", &defaults, 0.3);
     let mut flats = Scenario::table_4_4_flat();
     // As the runner's `--flat left:100:1.5:90 --flat left:60:0.8:250
     // --flat right:80:0:120:chord` builds them (mm and degrees).
@@ -68,5 +75,5 @@ fn main() {
     flats.flats[0].push(FlatSpec::haversine(mm(100.0), mm(1.5), deg(90.0)));
     flats.flats[0].push(FlatSpec::haversine(mm(60.0), mm(0.8), deg(250.0)));
     flats.flats[1].push(FlatSpec::chord(mm(80.0), deg(120.0)));
-    run("three more flats, 0.3 s", &flats, 0.3);
+    run("flats", "three more flats, 0.3 s", &flats, 0.3);
 }
