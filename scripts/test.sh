@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 echo "== Rust: format, lints, engine and FMI-layer tests"
 cargo fmt --check
 cargo clippy --all-targets -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 cargo build --release
 cargo test --release
 

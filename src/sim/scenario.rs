@@ -1,5 +1,5 @@
 //! The thesis' parameter sets as ready-made scenarios, with its misprints handled as
-//! `MODEL.md` says:
+//! `docs/MODEL.md` says:
 //!
 //! * Table 5.1 car body mass reads 1470.2 kg; 14702 kg gives the 82 kN static wheel
 //!   load used elsewhere for the same vehicle, so 14702 kg is used.

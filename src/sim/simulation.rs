@@ -1,6 +1,6 @@
 //! The coupled vehicle-track-contact simulation.
 //!
-//! One step, in the order of `MODEL.md`: at `t_j` the wheel displacements and the axle
+//! One step, in the order of `docs/MODEL.md`: at `t_j` the wheel displacements and the axle
 //! angle give the rail displacement under each wheel (3.23), then the contact forces
 //! `P_j`; vehicle and track are then advanced to `t_(j+1)` with `P_j`. The run starts
 //! from the static equilibrium of the whole system, solved directly
@@ -434,7 +434,7 @@ impl Simulation {
 
     /// Advances one step and returns the leading wheelset's sample at `t_j` whose
     /// contact forces drove it: wheel and rail displacements at `t_j` give the contact
-    /// forces `P_j`, which advance vehicle and track to `t_(j+1)` (`MODEL.md`).
+    /// forces `P_j`, which advance vehicle and track to `t_(j+1)` (`docs/MODEL.md`).
     ///
     /// Errors: the leading wheelset off the discrete track ([`Error::OffTrack`]); a
     /// value beyond the health bounds of [`crate::limits`] ([`Error::Diverged`]).

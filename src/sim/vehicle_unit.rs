@@ -4,7 +4,7 @@
 //! [`crate::sim::VehicleSpec::External`] wheels.
 //!
 //! Coupled with a communication step equal to the track's step, in the order of
-//! `MODEL.md` (vehicle outputs -> track inputs -> track outputs -> vehicle inputs ->
+//! `docs/MODEL.md` (vehicle outputs -> track inputs -> track outputs -> vehicle inputs ->
 //! both step), the pair performs exactly the arithmetic of the monolithic
 //! [`crate::sim::Simulation`].
 

@@ -8,7 +8,7 @@
 //!   the wheel load `W`.
 //! * [`LumpedTrack`]: the chapter-2 lumped track mass (2.27, second equation), one per rail.
 //!
-//! Roll angles are positive when they raise the right side (MODEL.md).
+//! Roll angles are positive when they raise the right side (docs/MODEL.md).
 
 mod lumped;
 mod roll_plane;

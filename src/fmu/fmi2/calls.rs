@@ -110,7 +110,7 @@ const STATUS: &[Phase] = &[Stc, Stf, Ter];
 /// The one table of the state machine: each function, its C name, and the phases it
 /// is allowed in, after the FMI 2.0 co-simulation state table (as the Reference-FMUs
 /// masks, without the phases these FMUs never enter). The C layer checks it before
-/// every call ([`Instance::check`]).
+/// every call ([`super::Instance::check`]).
 #[rustfmt::skip]
 pub const CALLS: [(Call, &str, Allowed); 34] = [
     (Call::GetTypesPlatform, "fmi2GetTypesPlatform", Allowed::NoInstance),
