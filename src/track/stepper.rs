@@ -13,26 +13,35 @@ pub struct PointLoad {
     pub force: f64,
 }
 
-/// Track state and its explicit time stepper.
+/// The discrete track and its explicit time stepper: two Timoshenko rails (deflection
+/// and rotation at every node, 3.4, 3.5) on rail pads (3.9), sleepers with bounce and
+/// roll on ballast (3.6-3.8), advanced by central differences (3.10-3.20) at a fixed
+/// step `dt` (s) no larger than the stability limit
+/// [`TrackParams::critical_time_step`]. Rail ends as [`TrackParams::ends`] says; a
+/// wheel acts as a [`PointLoad`] shared between the two nodes around it (3.21-3.23).
 ///
-/// Storage: rail nodes are kept by *phase* within a span so that every loop runs over
-/// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to `S`, a
-/// multiple of `LANES` (8), phase block `p = k % n` holds node `k` of rail `r` at
-/// `r S + k / n`, and the blocks are stored `1, 2, .., n - 1, 0` after `G = LANES`
-/// unused values (as many behind; arrays start on a cache line, so every block does
-/// too). Block 0 therefore holds the rail nodes above the sleepers, left rail then
-/// right rail, in sleeper order, and the sleeper loop reads it directly. Every block
-/// is stepped whole.
-///
-/// Slots past a rail's last node (one per rail in block 0 when `N_s < S`, more in
-/// blocks `1..n`, which have `N` nodes) are padding. No real node reads a padding
-/// slot, and padding slots read only padding, the rail ends and the guards (this is
-/// why block 0 comes last: the slot one past it, which the last slot of block `n - 1`
-/// reads, is the trailing guard and not node 1 of the left rail). Block 0's stencil
-/// masks its padding and the rail ends to zero, so with fixed ends the padding, the
-/// padded sleepers and their pads start at zero and stay there without a store after
-/// the loops; pinned ends, whose end rotations move, clear the padding after every
-/// step. Accessors return node order.
+/// Displacements are in m and rad, positive up (`docs/MODEL.md`); the accessors return
+/// node order, the left rail first. Errors of [`Track::new`]: any parameter out of its
+/// physical range, or `dt` above the stability limit.
+//
+// Storage (an implementation detail of the stepper's speed): rail nodes are kept by *phase* within a span so that every loop runs over
+// contiguous memory, in whole vectors. With `N_s = N + 1` sleepers padded to `S`, a
+// multiple of `LANES` (8), phase block `p = k % n` holds node `k` of rail `r` at
+// `r S + k / n`, and the blocks are stored `1, 2, .., n - 1, 0` after `G = LANES`
+// unused values (as many behind; arrays start on a cache line, so every block does
+// too). Block 0 therefore holds the rail nodes above the sleepers, left rail then
+// right rail, in sleeper order, and the sleeper loop reads it directly. Every block
+// is stepped whole.
+//
+// Slots past a rail's last node (one per rail in block 0 when `N_s < S`, more in
+// blocks `1..n`, which have `N` nodes) are padding. No real node reads a padding
+// slot, and padding slots read only padding, the rail ends and the guards (this is
+// why block 0 comes last: the slot one past it, which the last slot of block `n - 1`
+// reads, is the trailing guard and not node 1 of the left rail). Block 0's stencil
+// masks its padding and the rail ends to zero, so with fixed ends the padding, the
+// padded sleepers and their pads start at zero and stay there without a store after
+// the loops; pinned ends, whose end rotations move, clear the padding after every
+// step. Accessors return node order.
 #[derive(Debug, Clone)]
 pub struct Track {
     pub(super) params: TrackParams,
