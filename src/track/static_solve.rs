@@ -2,6 +2,7 @@
 //! the track) and the discrete energy.
 
 use super::*;
+use crate::numerics::solve_banded_spd;
 
 impl Track {
     /// Number of unknowns of the static problem.
@@ -162,66 +163,13 @@ impl Track {
         order
     }
 
-    /// Solves `K x = f` for the symmetric positive definite stiffness matrix by
-    /// Gaussian elimination on its band, unknowns taken in order along the track, the
-    /// band assembled directly from [`Track::stiffness_entries`]: `O(N b)` memory and
-    /// `O(N b^2)` time with half-bandwidth `b` of about 10, where the dense matrix
-    /// would take `O(N^2)` and `O(N^3)`. `None` when a pivot is not positive: `K` is
-    /// singular.
+    /// Solves `K x = f` for the symmetric positive definite stiffness matrix on its
+    /// band, the unknowns taken in order along the track (half-bandwidth about 10)
+    /// and the band assembled directly from [`Track::stiffness_entries`]. `None` when
+    /// `K` is singular.
     pub(super) fn solve_static_banded(&self, f: &[f64]) -> Option<Vec<f64>> {
         let order = self.static_order_along_track();
-        let n = order.len();
-        // Position along the track of each unknown.
-        let mut pos = vec![0; n];
-        for (i, &g) in order.iter().enumerate() {
-            pos[g] = i;
-        }
-        let mut bw = 0;
-        self.stiffness_entries(|i, j, v| {
-            if v != 0.0 {
-                bw = bw.max(pos[i].abs_diff(pos[j]));
-            }
-        });
-        let w = 2 * bw + 1;
-        let mut a = vec![0.0; n * w];
-        let at = |i: usize, j: usize| i * w + j + bw - i;
-        self.stiffness_entries(|i, j, v| {
-            if v != 0.0 {
-                a[at(pos[i], pos[j])] += v;
-            }
-        });
-        let mut b: Vec<f64> = order.iter().map(|&g| f[g]).collect();
-        let scale = (0..n).map(|i| a[at(i, i)].abs()).fold(0.0, f64::max);
-        for c in 0..n {
-            let pivot = a[at(c, c)];
-            if pivot.is_nan() || pivot <= 1e-14 * scale {
-                return None;
-            }
-            let end = (c + bw + 1).min(n);
-            for i in c + 1..end {
-                let l = a[at(i, c)] / pivot;
-                if l == 0.0 {
-                    continue;
-                }
-                for j in c + 1..end {
-                    a[at(i, j)] -= l * a[at(c, j)];
-                }
-                b[i] -= l * b[c];
-            }
-        }
-        let mut y = vec![0.0; n];
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..(i + bw + 1).min(n) {
-                s -= a[at(i, j)] * y[j];
-            }
-            y[i] = s / a[at(i, i)];
-        }
-        let mut x = vec![0.0; n];
-        for (i, &g) in order.iter().enumerate() {
-            x[g] = y[i];
-        }
-        x.iter().all(|v| v.is_finite()).then_some(x)
+        solve_banded_spd(&order, |add| self.stiffness_entries(add), f)
     }
 
     /// Discrete energy of the undamped scheme (J): `1/2 v^T M v + 1/2 x_(j-1)^T K x_j`
