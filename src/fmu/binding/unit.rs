@@ -31,6 +31,9 @@ pub struct FmuModel {
     kind: Kind,
     pub(super) engine: Engine,
     pub(super) published: Published,
+    /// The largest force a physical run reaches (N), [`force_limit`] of the static
+    /// loads.
+    force_limit: f64,
     /// The warning that the wheel nears the fixed rail end was given.
     end_warned: bool,
 }
@@ -54,6 +57,29 @@ impl FmuModel {
         match &self.engine {
             Engine::Vehicle(u) => Some(u),
             Engine::Sim(_) => None,
+        }
+    }
+
+    /// The refusal of a force `x` (N) beyond the force limit.
+    #[cold]
+    #[inline(never)]
+    fn force_fault(&self, spec: &VarSpec, x: f64, time: f64) -> OutputFault {
+        let cause = match self.kind {
+            Kind::TrackContact => {
+                "likely the wheel inputs press the wheel into the rail far beyond a running \
+                 wheel's overlap"
+            }
+            _ => "the run diverged, or its parameters are far from a railway",
+        };
+        OutputFault {
+            message: format!(
+                "`{}` = {} N at t = {time} s is beyond {} N ({FORCE_LIMIT_FACTOR} times the \
+                 static wheel load), which no physical run reaches: {cause}",
+                spec.name,
+                num(x),
+                num(self.force_limit),
+            ),
+            stops_run: self.kind != Kind::TrackContact,
         }
     }
 }
@@ -93,6 +119,7 @@ impl Model for FmuModel {
         Ok(FmuModel {
             kind,
             engine,
+            force_limit: force_limit(published.static_load),
             published,
             end_warned: false,
         })
@@ -140,28 +167,13 @@ impl Model for FmuModel {
     /// A force beyond [`FORCE_LIMIT_FACTOR`] times the static wheel load (at least 2 MN)
     /// is refused; for the FMUs whose forces are their own state (not TrackContact's,
     /// which come back with other inputs) it stops the run.
+    #[inline]
     fn check_output(&self, spec: &VarSpec, x: f64, time: f64) -> Result<(), OutputFault> {
-        let lim = force_limit(self.published.static_load);
-        if within(x, lim) || spec.unit != "N" {
-            return Ok(());
+        if within(x, self.force_limit) || spec.unit != "N" {
+            Ok(())
+        } else {
+            Err(self.force_fault(spec, x, time))
         }
-        let cause = match self.kind {
-            Kind::TrackContact => {
-                "likely the wheel inputs press the wheel into the rail far beyond a running \
-                 wheel's overlap"
-            }
-            _ => "the run diverged, or its parameters are far from a railway",
-        };
-        Err(OutputFault {
-            message: format!(
-                "`{}` = {} N at t = {time} s is beyond {} N ({FORCE_LIMIT_FACTOR} times the \
-                 static wheel load), which no physical run reaches: {cause}",
-                spec.name,
-                num(x),
-                num(lim),
-            ),
-            stops_run: self.kind != Kind::TrackContact,
-        })
     }
 
     /// `stopTime` beyond the time the wheel reaches the end of the track.
