@@ -34,8 +34,6 @@ pub struct FmuModel {
     /// The largest force a physical run reaches (N), [`force_limit`] of the static
     /// loads.
     force_limit: f64,
-    /// The warning that the wheel nears the fixed rail end was given.
-    end_warned: bool,
 }
 
 impl FmuModel {
@@ -121,7 +119,6 @@ impl Model for FmuModel {
             engine,
             force_limit: force_limit(published.static_load),
             published,
-            end_warned: false,
         })
     }
 
@@ -233,31 +230,25 @@ impl Model for FmuModel {
         }
     }
 
-    /// Once per run when the wheel comes within [`END_ZONE_SPANS`] sleeper spans of the
-    /// fixed rail end, where the end's reflections raise the impact forces (by 20 to
-    /// 35 % within the last span, table 4.4).
-    fn step_warning(&mut self, time: f64) -> Option<String> {
-        if self.end_warned {
-            return None;
-        }
+    /// When the wheel is within [`END_ZONE_SPANS`] sleeper spans of the fixed rail end,
+    /// where the end's reflections raise the impact forces (by 20 to 35 % within the
+    /// last span, table 4.4).
+    fn step_warning(&self, time: f64) -> Option<String> {
         let sim = self.simulation()?;
         let TrackSpec::Discrete(p) = &sim.scenario().track else {
             return None;
         };
         let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
         let x = sim.position();
-        if x <= zone {
-            return None;
-        }
-        let m = format!(
-            "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans of \
-             the fixed rail end at {:.3} m: the end's reflections raise impact forces here (by \
-             20 to 35 % within the last span); keep the impacts of interest at least \
-             {END_ZONE_SPANS} spans from the ends (track.spans)",
-            p.length()
-        );
-        self.end_warned = true;
-        Some(m)
+        (x > zone).then(|| {
+            format!(
+                "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans \
+                 of the fixed rail end at {:.3} m: the end's reflections raise impact forces \
+                 here (by 20 to 35 % within the last span); keep the impacts of interest at \
+                 least {END_ZONE_SPANS} spans from the ends (track.spans)",
+                p.length()
+            )
+        })
     }
 
     fn state_vector(&self) -> Result<Vec<f64>, Error> {

@@ -32,6 +32,9 @@ pub struct Instance<M: Model> {
     /// Why the run cannot go on (a value beyond the health bounds): `fmi2DoStep` and
     /// outputs are refused until `fmi2Reset` or `fmi2SetFMUstate`.
     pub(super) failed: Option<String>,
+    /// The run's step warning ([`Model::step_warning`]) was logged: once per run, until
+    /// `fmi2Reset` (FMU states leave it as it is).
+    pub(super) step_warned: bool,
     logger: Logger,
     logging_on: bool,
     categories: [bool; 4],
@@ -72,6 +75,7 @@ impl<M: Model> Instance<M> {
             stop_time: None,
             ended: false,
             failed: None,
+            step_warned: false,
             logger,
             logging_on,
             categories: [true; 4],
@@ -317,6 +321,7 @@ impl<M: Model> Instance<M> {
         self.stop_time = None;
         self.ended = false;
         self.failed = None;
+        self.step_warned = false;
         self.calculated = vec![0.0; M::CALCULATED];
         Ok(())
     }

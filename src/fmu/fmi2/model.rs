@@ -93,9 +93,9 @@ pub trait Model: Clone + Sized {
     /// How an error of [`Model::advance_to`] leaves the run.
     fn step_fault(e: &Error) -> StepFault;
 
-    /// A warning after a successful step at the communication time `time` (s), at most
-    /// once per run.
-    fn step_warning(&mut self, time: f64) -> Option<String>;
+    /// A warning about the state after a successful step at the communication time
+    /// `time` (s). The instance logs the first one of a run only (until `fmi2Reset`).
+    fn step_warning(&self, time: f64) -> Option<String>;
 
     /// Everything that determines the continuation, for serialized FMU states.
     fn state_vector(&self) -> Result<Vec<f64>, Error>;

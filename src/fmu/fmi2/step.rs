@@ -102,9 +102,12 @@ impl<M: Model> Instance<M> {
             return self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
-        let warning = self.model.as_mut().and_then(|m| m.step_warning(end));
-        if let Some(w) = warning {
-            self.warn(&format!("fmi2DoStep: {w}"));
+        if !self.step_warned {
+            let warning = self.model.as_ref().and_then(|m| m.step_warning(end));
+            if let Some(w) = warning {
+                self.step_warned = true;
+                self.warn(&format!("fmi2DoStep: {w}"));
+            }
         }
         Ok(())
     }

@@ -329,3 +329,51 @@ fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
     assert!(e.message.contains("rail deflection"), "{}", e.message);
     assert_eq!(log.lock().unwrap().len(), 1);
 }
+
+#[test]
+fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
+    let (mut i, log) = instance(Kind::CoupledSystem);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let warnings = |log: &Arc<Mutex<Vec<String>>>| {
+        log.lock()
+            .unwrap()
+            .iter()
+            .filter(|m| m.contains("fixed rail end"))
+            .count()
+    };
+    // Default track: 30 spans of 0.685 m, 20.55 m; the zone starts two spans before
+    // the end, at 19.18 m, which the wheel reaches from 1.37 m at 70 km/h at 0.916 s.
+    let h = 1e-3;
+    let mut t = 0.0;
+    while t < 0.9 - 1e-9 {
+        i.do_step(t, h).unwrap();
+        t = i.time();
+    }
+    assert_eq!(warnings(&log), 0, "not yet in the zone at {t} s");
+    let before = i.get_state().unwrap();
+    while t < 0.93 - 1e-9 {
+        i.do_step(t, h).unwrap();
+        t = i.time();
+    }
+    assert_eq!(warnings(&log), 1);
+    let after = i.get_state().unwrap();
+    let bytes = i.serialize(&after).unwrap();
+    let restored = i.deserialize(&bytes).unwrap();
+    // Restoring a state, in memory or serialized, before or in the zone, does not
+    // warn again in the same run.
+    for s in [&after, &restored, &before] {
+        i.set_state(s).unwrap();
+        let t = i.time();
+        i.do_step(t, 0.02).unwrap();
+        assert_eq!(warnings(&log), 1);
+    }
+    // A new run warns again.
+    i.reset().unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.set_state(&restored).unwrap();
+    let t = i.time();
+    i.do_step(t, h).unwrap();
+    assert_eq!(warnings(&log), 2);
+}
