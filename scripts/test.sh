@@ -12,7 +12,7 @@ cargo build --release
 cargo test --release
 
 echo "== FMUs: pack fmu/*.fmu and the C header"
-./target/release/build_fmus fmu
+"${CARGO_TARGET_DIR:-target}/release/build_fmus" fmu
 
 echo "== Python: .venv with fmpy, then the FMU tests"
 python3 python/wheelflat_fmus.py

@@ -8,7 +8,7 @@ use std::fmt;
 pub enum Error {
     /// A parameter outside its physical range.
     Parameter {
-        /// Parameter name, in the words of the seed (e.g. `track.pad.stiffness`).
+        /// Parameter name, in the words of the thesis (e.g. `track.pad.stiffness`).
         name: String,
         /// The value given.
         value: f64,

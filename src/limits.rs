@@ -4,14 +4,14 @@
 //!   `validate` functions check against it, and the FMUs' variable table
 //!   (`modelDescription/variables.xml`) declares the same `min`/`max` (a unit test in
 //!   `fmu` keeps the two equal), so an FMU refuses a value at `fmi2SetReal` already.
-//!   The ranges bracket every parameter set of the seed (chapter 2, tables 4.1, 4.4,
+//!   The ranges bracket every parameter set of the thesis (chapter 2, tables 4.1, 4.4,
 //!   5.1, 5.2) and standard-gauge freight and passenger vehicles and track with wide
 //!   margins; they exist so that no value inside them overflows the arithmetic
 //!   (a mass of 1e-300 kg or a stiffness of 1e308 N/m is not a railway).
 //! * The health bounds: a displacement of a decimetre at a rail or a wheel, or a
 //!   contact force of [`FORCE_LIMIT_FACTOR`] times the static wheel load, is reached by
 //!   no physical run (impact forces of wheel flats stay below about six times the
-//!   static load: seed chapter 1; this model gives 2.85 times for the reference flat).
+//!   static load: thesis chapter 1; this model gives 2.85 times for the reference flat).
 //!   Reaching one means the scheme diverged or the inputs are not a running wheel, and
 //!   the run stops with an error naming the quantity, the time and the likely cause.
 //! * The work bounds of one FMI call (see [`MAX_NODE_STEPS_PER_CALL`]).

@@ -10,7 +10,7 @@ use crate::wheel::WheelProfile;
 /// Which normal-contact law to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ContactModel {
-    /// The seed's adaptive radial-spring contact (2.8).
+    /// The thesis' adaptive radial-spring contact (2.8).
     Adaptive,
     /// Hertz point contact `P = C_H (delta_c - f_0)^(3/2)` (1.3).
     Hertz,

@@ -1,4 +1,4 @@
-//! Wheel-rail normal contact: the seed's adaptive radial-spring model (thesis 2.1-2.8,
+//! Wheel-rail normal contact: the thesis' adaptive radial-spring model (thesis 2.1-2.8,
 //! 2.22-2.26) and Hertz point contact (1.3) for comparison, behind one interface
 //! ([`ContactLaw`]), and the calibration of the radial stiffness `K_w` from a Hertz
 //! coefficient.

@@ -23,9 +23,10 @@ pub enum SimdLevel {
     /// AVX2 with FMA: 4 lanes of f64.
     Avx2,
     /// AVX-512F with FMA: 8 lanes of f64 in the track loops and the flat-in-patch
-    /// contact (the rest of the coupled step is compiled as for AVX2). On the Sapphire Rapids machines we run on, the
-    /// track step of the reference case (n = 2) takes about 115 ns against 150 ns
-    /// with AVX2 (`examples/profile_step`, fast phase of the machine).
+    /// contact (the rest of the coupled step is compiled as for AVX2).
+    // On the Sapphire Rapids machines we run on, the track step of the reference case
+    // (n = 2) takes about 115 ns against 150 ns with AVX2 (`examples/profile_step`,
+    // fast phase of the machine).
     Avx512,
 }
 

@@ -618,7 +618,13 @@ impl Simulation {
         Ok(())
     }
 
-    /// Runs until `duration` (s) from now, calling `each` with every sample.
+    /// Runs for `duration` (s) from now, rounded to a whole number of steps of
+    /// [`Simulation::dt`], calling `each` with the sample of every step as
+    /// [`Simulation::step`] returns it (at the step's start `t_j`).
+    ///
+    /// Errors: `duration` negative or not finite; the errors of [`Simulation::step`]
+    /// (the wheel leaving the track, a value beyond the health bounds), after which
+    /// the samples up to the failing step have been handed to `each`.
     pub fn run(&mut self, duration: f64, mut each: impl FnMut(&Sample)) -> Result<()> {
         non_negative("duration", duration, "s")?;
         let n = (duration / self.clock.dt).round() as u64;

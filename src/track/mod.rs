@@ -12,10 +12,6 @@
 //! `F = -K_p (Z_rail - Z_seat) - C_p (dZ_rail/dt - dZ_seat/dt)` acts up on the rail and
 //! down on the sleeper; pad damper velocities are backward differences so the rail
 //! update stays explicit; ballast damping uses central differences (3.18).
-//!
-//! The rail update is written as one stencil loop over both rails stored end to end
-//! (the fixed end nodes separate them), with no allocation and no bounds checks, so
-//! the compiler vectorises it.
 
 mod kernels;
 mod params;

@@ -54,7 +54,7 @@ impl RailSection {
 /// End conditions of the rails.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RailEnds {
-    /// `Z = theta = 0` at both ends (the seed's model).
+    /// `Z = theta = 0` at both ends (the thesis' model).
     Fixed,
     /// `Z = 0`, zero moment (`dtheta/dx = 0`) at both ends; used to verify the rail
     /// against the closed-form simply supported Timoshenko beam.
@@ -145,12 +145,12 @@ impl TrackParams {
     /// most the largest eigenvalue of one sleeper with its two pads and ballast (Weyl's
     /// inequality), so `dt_c = 2 / omega_max` is a sufficient bound for the undamped
     /// scheme. The explicit pad damper on the deflection branch adds the condition
-    /// `lambda dt^2 + 2 eta dt <= 4`. For table 4.1 this gives the seed's table 4.2.
+    /// `lambda dt^2 + 2 eta dt <= 4`. For table 4.1 this gives the thesis' table 4.2.
     ///
     /// The wheel/rail contact spring is not in this bound, and does not need to be:
     /// [`TrackParams::critical_time_step_with_contact`] bounds the scheme with it and
     /// gives the same value, bit for bit, for every contact stiffness the adaptive law
-    /// reaches on the seed's tracks (table 4.4 at n = 1..10 up to 20 times the static
+    /// reaches on the thesis' tracks (table 4.4 at n = 1..10 up to 20 times the static
     /// load, a flat in the patch included); `examples/stability_limit.rs` measures the
     /// stepper's threshold with the contact spring, unchanged to 1e-6.
     pub fn critical_time_step(&self) -> (f64, String) {

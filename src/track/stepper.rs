@@ -326,8 +326,13 @@ impl Track {
 }
 
 impl Track {
-    /// Sets the state at t_j and t_(j-1) directly (for tests and restarts): rail
-    /// deflection and rotation of both rails end to end, then sleepers.
+    /// Sets the rail state at t_j and t_(j-1) directly (for tests and restarts): rail
+    /// deflections `z`, `z_prev` (m) and rotations `th`, `th_prev` (rad), each of the
+    /// left rail's nodes `0..=K` followed by the right rail's, `2 (K + 1)` values
+    /// ([`Track::nodes`] is `K + 1`). The sleepers keep their state.
+    ///
+    /// # Panics
+    /// When a slice is shorter than `2 (K + 1)`.
     pub fn set_state(&mut self, z: &[f64], th: &[f64], z_prev: &[f64], th_prev: &[f64]) {
         let (slot, sp) = (&self.slot, self.sp);
         Self::from_nodes(slot, sp, z, &mut self.z);

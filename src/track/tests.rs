@@ -250,7 +250,7 @@ fn critical_steps_reproduce_seed_table_4_2() {
     ];
     for (n, dtc) in seed {
         let (ours, _) = seed_track(20, n).critical_time_step();
-        // The seed found its values by trial to 1 us.
+        // The thesis found its values by trial to 1 us.
         assert!((ours - dtc).abs() < 1.5e-6, "n = {n}: {ours} vs {dtc}");
     }
 }

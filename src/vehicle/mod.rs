@@ -1,6 +1,6 @@
 //! Vehicle models and the alternative loads on the track.
 //!
-//! * [`RollPlaneVehicle`]: the seed's six-degree-of-freedom half-bogie roll-plane model
+//! * [`RollPlaneVehicle`]: the thesis' six-degree-of-freedom half-bogie roll-plane model
 //!   (3.1-3.3), `d = {z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`, with gravity on every body,
 //!   advanced by central differences with damping as in (3.25).
 //! * [`LumpedWheels`]: the chapter-2 lumped model's wheel (2.27, first equation), one

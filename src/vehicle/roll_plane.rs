@@ -1,4 +1,4 @@
-//! The seed's six-degree-of-freedom roll-plane vehicle (3.1-3.3):
+//! The thesis' six-degree-of-freedom roll-plane vehicle (3.1-3.3):
 //! `d = {z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`, gravity on every body, advanced by
 //! central differences with damping as in (3.25).
 

@@ -22,7 +22,7 @@ pub enum FlatShape {
 pub struct FlatSpec {
     /// Flat length `l_f` (m).
     pub length: f64,
-    /// Flat depth `D_f` (m). `None` takes the seed's default: (2.15) for a
+    /// Flat depth `D_f` (m). `None` takes the thesis' default: (2.15) for a
     /// haversine flat, (2.13) for a chord flat.
     pub depth: Option<f64>,
     /// Wheel angle of the flat centre at zero axle rotation, `beta_0` (rad).
@@ -94,7 +94,7 @@ impl Flat {
     /// D/2 (1 - cos(2 pi x / l)) = D sin^2(pi x / l) = D cos^2 u with
     /// u = pi x / l - pi/2 = k_tan tan psi. u is clamped to [-pi/2, pi/2]
     /// (x to [0, l_f]) so that the profile is continuous at the flat ends
-    /// (the seed's x misses 0 by ~1e-5 l_f).
+    /// (the thesis' x misses 0 by ~1e-5 l_f).
     #[inline(always)]
     fn haversine_of_tan(&self, tan_psi: f64) -> f64 {
         let u = (self.k_tan * tan_psi).clamp(-0.5 * PI, 0.5 * PI);
