@@ -259,18 +259,11 @@ pub(super) fn slice<'a, T>(
     p: *const T,
     n: usize,
 ) -> FmiResult<&'a [T]> {
-    if p.is_null() {
-        return inst.refuse(
-            Status::Error,
-            format!(
-                "{}: argument `{what}` is a null pointer (count {n})",
-                call.name()
-            ),
-        );
-    }
+    non_null(inst, call, what, p, n)?;
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
+/// A mutable slice from a C array; see [`slice`].
 pub(super) fn slice_mut<'a, T>(
     inst: &mut Instance,
     call: Call,
@@ -278,6 +271,12 @@ pub(super) fn slice_mut<'a, T>(
     p: *mut T,
     n: usize,
 ) -> FmiResult<&'a mut [T]> {
+    non_null(inst, call, what, p, n)?;
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// Refuses a null array pointer `p` (with `n` values announced).
+fn non_null<T>(inst: &mut Instance, call: Call, what: &str, p: *const T, n: usize) -> FmiResult {
     if p.is_null() {
         return inst.refuse(
             Status::Error,
@@ -287,7 +286,7 @@ pub(super) fn slice_mut<'a, T>(
             ),
         );
     }
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+    Ok(())
 }
 
 /// A null pointer argument refused.
