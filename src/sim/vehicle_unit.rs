@@ -156,9 +156,27 @@ impl VehicleUnit {
     }
 
     /// Sets the contact forces `[left, right]` (N) held over the next communication step.
+    ///
+    /// Errors: a force not finite, or beyond [`crate::limits::force_limit`] of the
+    /// static loads (20 times the larger, at least 2 MN), which no physical run reaches;
+    /// nothing is set then.
     pub fn set_forces(&mut self, p: [f64; 2]) -> Result<()> {
-        finite("contact.left.force", p[0], "N")?;
-        finite("contact.right.force", p[1], "N")?;
+        let lim = crate::limits::force_limit(self.static_load());
+        for (name, x) in [("contact.left.force", p[0]), ("contact.right.force", p[1])] {
+            finite(name, x, "N")?;
+            if !crate::limits::within(x, lim) {
+                return Err(crate::error::out_of_range(
+                    name,
+                    x,
+                    format!(
+                        "|{name}| <= {} N ({} times the static wheel load), which no physical \
+                         run exceeds",
+                        crate::error::num(lim),
+                        crate::limits::FORCE_LIMIT_FACTOR
+                    ),
+                ));
+            }
+        }
         self.force = p;
         Ok(())
     }

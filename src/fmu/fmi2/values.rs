@@ -118,9 +118,14 @@ impl<M: Model> Instance<M> {
     fn set(&mut self, call: Call, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
         self.check(call)?;
         let call = call.name();
+        let (mut inputs, mut parameters) = (false, false);
         for (&r, &x) in vrs.iter().zip(vals) {
             let s = self.spec(call, r)?;
             self.check_type(call, s, real)?;
+            match s.causality {
+                Causality::Parameter => parameters = true,
+                _ => inputs = true,
+            }
             let settable = matches!(
                 (s.causality, self.phase),
                 (Causality::Input, _)
@@ -164,19 +169,32 @@ impl<M: Model> Instance<M> {
                 );
             }
         }
-        let mut inputs = false;
-        for (&r, &x) in vrs.iter().zip(vals) {
-            let s = self.known_spec(r);
-            self.values[s.vr as usize] = x;
-            match s.causality {
-                Causality::Parameter => self.dirty = true,
-                _ => inputs = true,
-            }
-        }
         // A set call that changed a parameter rebuilds the model (with every input)
-        // before it is next used; otherwise every reference of the call is an input.
-        if inputs && self.model.is_some() && !self.dirty {
-            self.sync_inputs(vrs)?;
+        // before it is next used; otherwise every reference of the call is an input,
+        // and the model takes them all or none (the values it refused are restored).
+        let sync = inputs && self.model.is_some() && !self.dirty && !parameters;
+        let mut kept = [0.0; 8];
+        let kept_many: Vec<f64>;
+        let before: &[f64] = if !sync {
+            &[]
+        } else if vrs.len() <= kept.len() {
+            for (k, &r) in kept.iter_mut().zip(vrs) {
+                *k = self.values[r as usize];
+            }
+            &kept[..vrs.len()]
+        } else {
+            kept_many = vrs.iter().map(|&r| self.values[r as usize]).collect();
+            &kept_many
+        };
+        for (&r, &x) in vrs.iter().zip(vals) {
+            self.values[r as usize] = x;
+        }
+        self.dirty |= parameters;
+        if sync && let Err(e) = self.sync_inputs(vrs) {
+            for (&r, &x) in vrs.iter().zip(before) {
+                self.values[r as usize] = x;
+            }
+            return Err(e);
         }
         Ok(())
     }

@@ -377,3 +377,38 @@ fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
     i.do_step(t, h).unwrap();
     assert_eq!(warnings(&log), 2);
 }
+
+#[test]
+fn vehicle_forces_no_physical_run_reaches_are_refused_at_set_and_change_nothing() {
+    let (mut v, _) = instance(Kind::RollPlaneVehicle);
+    v.enter_initialization().unwrap();
+    v.exit_initialization().unwrap();
+    let w = v.value(vr::CONTACT_LEFT_FORCE);
+    // 20 times the static wheel load of table 4.4 (107.66 kN), at least 2 MN.
+    let limit = crate::limits::force_limit([w, w]);
+    assert_eq!(limit, 20.0 * w);
+    let e = v
+        .set_real(
+            &[vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
+            &[w, 1.01 * limit],
+        )
+        .unwrap_err();
+    assert_eq!(e.status, Status::Error);
+    assert!(
+        e.message.contains("contact.right.force") && e.message.contains("2153295 N"),
+        "{}",
+        e.message
+    );
+    // Neither force was taken: the run goes on at the static loads, which hold the
+    // vehicle where it is.
+    assert_eq!(v.value(vr::CONTACT_RIGHT_FORCE), w);
+    let z0 = real(&mut v, vr::WHEEL_RIGHT_Z);
+    v.do_step(0.0, 1e-3).unwrap();
+    assert!((real(&mut v, vr::WHEEL_RIGHT_Z) - z0).abs() < 1e-9);
+    assert_eq!(real(&mut v, vr::CONTACT_RIGHT_MAX_FORCE), w);
+    // Just inside the bound is taken.
+    v.set_real(&[vr::CONTACT_RIGHT_FORCE], &[0.99 * limit])
+        .unwrap();
+    v.do_step(1e-3, 1e-3).unwrap();
+    assert_eq!(real(&mut v, vr::CONTACT_RIGHT_MAX_FORCE), 0.99 * limit);
+}
