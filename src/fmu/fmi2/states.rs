@@ -167,6 +167,17 @@ impl<M: Model> Instance<M> {
         let phase = Phase::from_u8(p).ok_or_else(|| format!("bad phase {p}"))?;
         let ended = r.take(1)?[0] != 0;
         let has_model = r.take(1)?[0] != 0;
+        // Stepping phases always have a model (only fmi2Reset and an internal error drop
+        // it), and none has been built before initialisation.
+        match (phase, has_model) {
+            (Phase::StepComplete | Phase::StepFailed | Phase::Terminated, false) => {
+                return Err(format!("a state in phase {phase:?} without a model"));
+            }
+            (Phase::Instantiated, true) => {
+                return Err("a state in phase Instantiated with a model".into());
+            }
+            _ => {}
+        }
         let time = r.f64()?;
         let start_time = r.f64()?;
         let n = r.u64()? as usize;

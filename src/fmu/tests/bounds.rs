@@ -230,6 +230,8 @@ fn a_doctored_state_is_refused_and_leaves_the_instance_as_it_was() {
             put(time_at, &0.5f64.to_le_bytes()),
             "disagrees with the model's clock",
         ),
+        // a stepping state without its model (it would restart the model at t = 0)
+        (put(time_at - 1, &[0]), "phase StepComplete without a model"),
     ] {
         let e = i.deserialize(&bytes).unwrap_err();
         assert!(e.message.contains(why), "{why}: {}", e.message);
