@@ -14,6 +14,7 @@
 //! update stays explicit; ballast damping uses central differences (3.18).
 
 mod kernels;
+mod observe;
 mod params;
 mod probe;
 mod state;
@@ -24,6 +25,7 @@ mod storage;
 mod tests;
 
 pub use crate::numerics::SimdLevel;
+pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
 pub use stepper::{PointLoad, Track};
