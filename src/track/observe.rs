@@ -98,18 +98,24 @@ impl Track {
 }
 
 #[cfg(test)]
-mod tests {
+mod tests_support {
     use super::*;
     use crate::sim::{Scenario, TrackSpec};
 
     /// The table 4.4 track at the converged grid, `spans` long.
-    fn track(spans: usize) -> Track {
+    pub fn track(spans: usize) -> Track {
         let TrackSpec::Discrete(mut p) = Scenario::table_4_4().track else {
             unreachable!("table 4.4 has the discrete track")
         };
         p.spans = spans;
         Track::new(p, 1e-5).unwrap()
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tests_support::*;
+    use super::*;
 
     /// A static wheel load of 107.66 kN per rail at `x` (m).
     fn loaded(spans: usize, x: f64) -> (Track, f64) {
@@ -241,5 +247,76 @@ mod tests {
             moments[0].1 < winkler && winkler < moments[1].1,
             "{winkler}"
         );
+    }
+}
+
+#[cfg(test)]
+mod superposition {
+    use super::tests_support::*;
+    use super::*;
+
+    /// The track is linear: the static state under the wheel loads of several
+    /// wheelsets (a four-axle wagon: bogie wheelbase 1.8 m, bogie centres 10 m apart,
+    /// unequal loads) is the sum of the states under each wheelset alone.
+    #[test]
+    fn static_states_of_several_wheelsets_superpose() {
+        let positions = [25.0, 23.2, 15.0, 13.2];
+        let forces = [107e3, 98e3, 112e3, 90e3];
+        let loads_of = |w: usize| {
+            [0, 1].map(|rail| PointLoad {
+                rail,
+                position: positions[w],
+                force: forces[w] * if rail == 0 { 1.0 } else { 0.9 },
+            })
+        };
+        let mut all = track(60);
+        let every: Vec<PointLoad> = (0..4).flat_map(loads_of).collect();
+        all.set_static(&every).unwrap();
+        let mut sum = vec![0.0; 2 * all.nodes()];
+        let mut seats = [0.0; 2];
+        for w in 0..4 {
+            let mut one = track(60);
+            one.set_static(&loads_of(w)).unwrap();
+            for (s, z) in sum
+                .iter_mut()
+                .zip(one.rail_z(0).into_iter().chain(one.rail_z(1)))
+            {
+                *s += z;
+            }
+            for (rail, seat) in seats.iter_mut().enumerate() {
+                *seat += one.support_response(rail, 24.66).rail_seat_force;
+            }
+        }
+        let scale = sum.iter().fold(0.0f64, |m, z| m.max(z.abs()));
+        let together: Vec<f64> = all.rail_z(0).into_iter().chain(all.rail_z(1)).collect();
+        for (k, (a, b)) in together.iter().zip(&sum).enumerate() {
+            assert!((a - b).abs() <= 1e-9 * scale, "node {k}: {a} against {b}");
+        }
+        for (rail, seat) in seats.iter().enumerate() {
+            let a = all.support_response(rail, 24.66).rail_seat_force;
+            assert!((a - seat).abs() <= 1e-9 * 107e3, "{a} against {seat}");
+        }
+        // The trailing wheelset of a bogie deflects the rail under the leading one.
+        let mut lead = track(60);
+        lead.set_static(&loads_of(0)).unwrap();
+        let mut bogie = track(60);
+        bogie
+            .set_static(&[loads_of(0), loads_of(1)].concat())
+            .unwrap();
+        let (alone, both) = (
+            lead.rail_response(0, 25.0).displacement,
+            bogie.rail_response(0, 25.0).displacement,
+        );
+        // It adds 3.9 % to the leading wheel's deflection; the Winkler foundation's
+        // influence line `exp(-beta x) (cos beta x + sin beta x)` at 1.8 m gives 4.0 %.
+        let t = track(60);
+        let pr = t.params();
+        let k = pr.pad_stiffness * pr.ballast_stiffness
+            / (pr.pad_stiffness + pr.ballast_stiffness)
+            / pr.sleeper_spacing;
+        let bx = (k / (4.0 * pr.rail.ei)).powf(0.25) * 1.8;
+        let winkler = (-bx).exp() * (bx.cos() + bx.sin()) * forces[1] / forces[0];
+        let added = both / alone - 1.0;
+        assert!((added - winkler).abs() < 0.005, "{added} against {winkler}");
     }
 }
