@@ -8,6 +8,7 @@ mod health;
 mod inputs;
 mod scenario;
 mod simulation;
+mod sites;
 mod state;
 mod static_start;
 #[cfg(test)]
@@ -20,5 +21,6 @@ pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, VehicleSpec, kmh,
 };
 pub use simulation::{CONTACT_STIFFNESS_MARGIN, Simulation, TrackState, VehicleState, default_dt};
+pub use sites::{SITE_QUANTITIES, Site, SiteValues};
 pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
 pub use wheelset::{Sample, Wheelset, Wheelsets};

@@ -69,6 +69,9 @@ pub struct Scenario {
     pub start_position: f64,
     /// Time step (s); 0 takes the converged default.
     pub dt: f64,
+    /// Observation points (m along the track, at most [`crate::limits::MAX_SITES`]):
+    /// what the discrete track feels there, with extremes ([`super::Site`]).
+    pub sites: Vec<f64>,
 }
 
 /// Grid nodes per sleeper span used by default: the converged choice of the grid
@@ -131,6 +134,7 @@ impl Scenario {
             speed: kmh(70.0),
             start_position: 2.0 * 0.685,
             dt: 0.0,
+            sites: Vec::new(),
         }
     }
 
@@ -202,6 +206,7 @@ impl Scenario {
             speed: kmh(100.0),
             start_position: 2.0 * 0.6069,
             dt: 0.0,
+            sites: Vec::new(),
         }
     }
 
@@ -292,6 +297,7 @@ impl Scenario {
             speed: kmh(50.0),
             start_position: 0.0,
             dt: 1e-6,
+            sites: Vec::new(),
         }
     }
 

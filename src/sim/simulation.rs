@@ -7,6 +7,7 @@
 //! ([`super::static_start`]).
 
 use super::clock::{Clock, StepPlan, Stepping};
+use super::sites::{Site, sites};
 use super::static_start::{contact_law, static_loads};
 use super::wheelset::{Sample, Wheelset, Wheelsets, contact_states, wheel_loads};
 use crate::contact::ContactLaw;
@@ -77,6 +78,8 @@ pub struct Simulation {
     pub(super) force_limit: f64,
     /// Instructions the whole coupled step is compiled for (see [`Simulation::step`]).
     pub(super) simd: SimdLevel,
+    /// The observation points ([`Scenario::sites`]).
+    pub(super) sites: Vec<Site>,
 }
 
 /// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]).
@@ -229,10 +232,20 @@ impl Simulation {
             critical_step: critical.map_or(f64::NAN, |c| c.0),
             force_limit: force_limit(static_load),
             simd: SimdLevel::detect(),
+            sites: Vec::new(),
         };
         sim.set_static()?;
         sim.check_static_sag()?;
         sim.check_states()?;
+        match &sim.track {
+            TrackState::Discrete(t) => sim.sites = sites(t, &s.sites)?,
+            TrackState::Lumped(_) if !s.sites.is_empty() => {
+                return Err(Error::Unsupported(
+                    "observation points on the lumped track (it has no rails)".into(),
+                ));
+            }
+            TrackState::Lumped(_) => {}
+        }
         Ok(sim)
     }
 
@@ -247,6 +260,11 @@ impl Simulation {
     /// Steps taken.
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+    /// The observation points ([`Scenario::sites`]), with what the track feels there at
+    /// `t_j` and its extremes since the start.
+    pub fn sites(&self) -> &[Site] {
+        &self.sites
     }
     /// Position of the leading wheelset at the current time (m): `x_0 + V t`.
     pub fn position(&self) -> f64 {
@@ -579,7 +597,12 @@ impl Simulation {
         match &mut self.track {
             TrackState::Discrete(t) => {
                 wheel_loads(x, &self.wheelsets, Wheelset::forces, &mut self.loads);
-                t.step(&self.loads)
+                t.step(&self.loads);
+                if !self.sites.is_empty() {
+                    for site in &mut self.sites {
+                        site.record(t);
+                    }
+                }
             }
             TrackState::Lumped(t) => t.step(p),
         }

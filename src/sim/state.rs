@@ -3,6 +3,7 @@
 
 use super::clock::ForceExtremes;
 use super::simulation::{Simulation, TrackState, VehicleState};
+use super::sites::Site;
 use crate::error::{Error, Result, num, out_of_range};
 use crate::limits::MIN_DT_FRACTION;
 
@@ -26,6 +27,9 @@ impl Simulation {
         let mut v = vec![c.dt, c.t0, c.k as f64, self.steps as f64];
         for w in self.wheelsets.iter() {
             v.extend(w.extremes.to_array());
+        }
+        for site in &self.sites {
+            v.extend(site.extremes());
         }
         match &self.track {
             TrackState::Discrete(t) => v.extend(t.state_vector()),
@@ -86,7 +90,8 @@ impl Simulation {
             TrackState::Lumped(_) => return Err(Self::no_state()),
         };
         let nv = self.vehicle_state()?.len();
-        let head = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
+        let extremes_end = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
+        let head = extremes_end + Site::STATE_LEN * self.sites.len();
         if v.len() != head + nt + nv {
             return Err(out_of_range(
                 "simulation state length",
@@ -114,9 +119,15 @@ impl Simulation {
         let c = &mut self.clock;
         (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);
         self.steps = v[3] as u64;
-        let extremes = v[CLOCK..head].chunks_exact(ForceExtremes::LEN);
+        let extremes = v[CLOCK..extremes_end].chunks_exact(ForceExtremes::LEN);
         for (w, x) in self.wheelsets.iter_mut().zip(extremes) {
             w.extremes = ForceExtremes::from_slice(x);
+        }
+        if let TrackState::Discrete(t) = &self.track {
+            let stored = v[extremes_end..head].chunks_exact(Site::STATE_LEN);
+            for (site, x) in self.sites.iter_mut().zip(stored) {
+                site.restore(t, x);
+            }
         }
         self.clear_cache();
         self.check_health()

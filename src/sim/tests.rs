@@ -281,3 +281,76 @@ fn force_extremes_take_every_step_in() {
         [5.0, 6.0, 5.0, 6.0]
     );
 }
+
+/// A perfect wheel rolling over an observation point on a sleeper (70 km/h, table 4.4):
+/// the extremes hold the largest and smallest value of every step, and the largest
+/// rail seat force is within 3 % above the quasi-static one of a wheel standing over the
+/// sleeper.
+#[test]
+fn a_site_records_what_the_track_feels_as_the_wheel_passes() {
+    let site = 12.0 * 0.685;
+    let mut s = Scenario::table_4_4();
+    s.sites = vec![site];
+    let mut sim = Simulation::new(&s).unwrap();
+    let mut seen_max = *sim.sites()[0].now();
+    let mut seen_min = seen_max;
+    // The wheel passes the site at 0.35 s; run to 0.5 s.
+    let n = (0.5 / sim.dt()).round() as u64;
+    for _ in 0..n {
+        sim.step().unwrap();
+        let now = sim.sites()[0].now();
+        for rail in 0..2 {
+            for q in 0..6 {
+                seen_max[rail][q] = seen_max[rail][q].max(now[rail][q]);
+                seen_min[rail][q] = seen_min[rail][q].min(now[rail][q]);
+            }
+        }
+    }
+    assert_eq!(sim.sites()[0].max(), &seen_max);
+    assert_eq!(sim.sites()[0].min(), &seen_min);
+    // The quasi-static seat force under a wheel standing over the sleeper.
+    let TrackSpec::Discrete(p) = s.track else {
+        unreachable!()
+    };
+    let mut t = crate::track::Track::new(p, sim.dt()).unwrap();
+    let w = sim.static_load();
+    let loads = [0, 1].map(|rail| crate::track::PointLoad {
+        rail,
+        position: site,
+        force: w[rail],
+    });
+    t.set_static(&loads).unwrap();
+    let still = t.support_response(0, site).rail_seat_force;
+    let passing = sim.sites()[0].max()[0][3];
+    // 45.02 kN passing against 44.25 kN standing: 1.8 % dynamic at 70 km/h.
+    assert!(
+        (0.0..0.03).contains(&(passing / still - 1.0)),
+        "{passing} against {still}"
+    );
+}
+
+/// Observation points travel with the state vector: a restored run continues with the
+/// same extremes, bit for bit; too many points or one off the track are refused.
+#[test]
+fn sites_restore_with_the_state_and_are_checked() {
+    let mut s = Scenario::table_4_4_flat();
+    s.sites = vec![3.0, 5.5];
+    let mut a = Simulation::new(&s).unwrap();
+    for _ in 0..5000 {
+        a.step().unwrap();
+    }
+    let v = a.state_vector().unwrap();
+    let mut b = Simulation::new(&s).unwrap();
+    b.set_state_vector(&v).unwrap();
+    for _ in 0..5000 {
+        a.step().unwrap();
+        b.step().unwrap();
+    }
+    assert_eq!(a.sites(), b.sites());
+    s.sites = vec![1.0; 9];
+    let e = Simulation::new(&s).unwrap_err().to_string();
+    assert!(e.contains("at most 8"), "{e}");
+    s.sites = vec![25.0];
+    let e = Simulation::new(&s).unwrap_err().to_string();
+    assert!(e.contains("site position") && e.contains("20.55"), "{e}");
+}

@@ -113,5 +113,6 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         speed: val(vr::SPEED),
         start_position: val(vr::START_POSITION),
         dt: val(vr::SOLVER_DT),
+        sites: Vec::new(),
     }
 }

@@ -1,0 +1,136 @@
+//! Observation points fixed in track coordinates: what the track feels there at every
+//! step (rail displacement, bending moment and shear force; at the nearest sleeper the
+//! rail seat force, the seat's displacement and the ballast force, for both rails),
+//! with the extremes since the start, so that a coarse output never hides a passing
+//! peak.
+
+use crate::error::{Result, out_of_range};
+use crate::limits::MAX_SITES;
+use crate::track::Track;
+
+/// The quantities recorded at a site for each rail, in the order of [`SiteValues`]:
+/// rail displacement (m), rail bending moment (N m), rail shear force (N), rail seat
+/// force (N), seat displacement (m), ballast force (N) (see
+/// [`crate::track::RailResponse`] and [`crate::track::SupportResponse`]).
+pub const SITE_QUANTITIES: [&str; 6] = [
+    "rail.z",
+    "rail.bending_moment",
+    "rail.shear_force",
+    "seat.force",
+    "seat.z",
+    "ballast.force",
+];
+
+/// The values of [`SITE_QUANTITIES`] on the left (0) and right (1) rail.
+pub type SiteValues = [[f64; 6]; 2];
+
+/// One observation point: its position and what the track feels there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Site {
+    position: f64,
+    now: SiteValues,
+    max: SiteValues,
+    min: SiteValues,
+}
+
+impl Site {
+    /// Position along the track (m).
+    pub fn position(&self) -> f64 {
+        self.position
+    }
+    /// The values at the current time `t_j`.
+    pub fn now(&self) -> &SiteValues {
+        &self.now
+    }
+    /// The largest values since the start (the static state included).
+    pub fn max(&self) -> &SiteValues {
+        &self.max
+    }
+    /// The smallest values since the start.
+    pub fn min(&self) -> &SiteValues {
+        &self.min
+    }
+
+    /// What `track` feels at `x` (m) now.
+    fn read(track: &Track, x: f64) -> SiteValues {
+        [0, 1].map(|rail| {
+            let r = track.rail_response(rail, x);
+            let s = track.support_response(rail, x);
+            [
+                r.displacement,
+                r.bending_moment,
+                r.shear_force,
+                s.rail_seat_force,
+                s.seat_displacement,
+                s.ballast_force,
+            ]
+        })
+    }
+
+    /// Reads the track now and takes the values into the extremes.
+    pub(crate) fn record(&mut self, track: &Track) {
+        self.now = Self::read(track, self.position);
+        for rail in 0..2 {
+            for q in 0..6 {
+                let x = self.now[rail][q];
+                self.max[rail][q] = self.max[rail][q].max(x);
+                self.min[rail][q] = self.min[rail][q].min(x);
+            }
+        }
+    }
+
+    /// Values of the extremes in the order state vectors store them.
+    pub(crate) fn extremes(&self) -> impl Iterator<Item = f64> + '_ {
+        self.max.iter().chain(&self.min).flatten().copied()
+    }
+
+    /// Number of values [`Site::extremes`] yields.
+    pub(crate) const STATE_LEN: usize = 24;
+
+    /// Restores the extremes from [`Site::extremes`] and reads the track now.
+    pub(crate) fn restore(&mut self, track: &Track, v: &[f64]) {
+        for (k, &x) in v.iter().enumerate().take(Self::STATE_LEN) {
+            let (half, rail, q) = (k / 12, (k / 6) % 2, k % 6);
+            if half == 0 {
+                self.max[rail][q] = x;
+            } else {
+                self.min[rail][q] = x;
+            }
+        }
+        self.now = Self::read(track, self.position);
+    }
+}
+
+/// The observation points at `positions` (m) on `track`, their extremes started at the
+/// track's current state.
+///
+/// Errors: more than [`MAX_SITES`] points, or a point outside the track.
+pub(crate) fn sites(track: &Track, positions: &[f64]) -> Result<Vec<Site>> {
+    if positions.len() > MAX_SITES {
+        return Err(out_of_range(
+            "sites",
+            positions.len() as f64,
+            format!("at most {MAX_SITES} observation points"),
+        ));
+    }
+    let len = track.params().length();
+    positions
+        .iter()
+        .map(|&x| {
+            if !(x > 0.0 && x < len) {
+                return Err(out_of_range(
+                    "site position",
+                    x,
+                    format!("0 m < site position < {len} m (the track)"),
+                ));
+            }
+            let now = Site::read(track, x);
+            Ok(Site {
+                position: x,
+                now,
+                max: now,
+                min: now,
+            })
+        })
+        .collect()
+}
