@@ -3,7 +3,7 @@
 //! ```text
 //! wheelflat [--preset table4.4-flat] [--speed KMH] [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:chord]]...
 //!           [--no-flats] [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5]
-//!           [--n NODES_PER_SPAN] [--dt-us US] [--spans N] [--start M] [--duration S]
+//!           [--n NODES_PER_SPAN] [--dt-us US] [--spans N] [--start M] [--site M]... [--duration S]
 //!           [--every K] [--output FILE.csv]
 //! ```
 
@@ -17,7 +17,7 @@ use wheelflat::wheel::{FlatShape, FlatSpec};
 const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:haversine|chord]]... [--no-flats] \
 [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5] [--n NODES_PER_SPAN] [--dt-us US] \
-[--spans N] [--start M] [--duration S] [--every K] [--output FILE.csv]
+[--spans N] [--start M] [--site M]... [--duration S] [--every K] [--output FILE.csv]
 presets: table4.4 table4.4-flat (default) table4.1 table5.1 table5.2 chapter2";
 
 fn num(flag: &str, v: Option<String>) -> Result<f64, String> {
@@ -121,6 +121,7 @@ fn run() -> Result<(), String> {
             }
             "--dt-us" => scenario.dt = num(&flag, v)? * 1e-6,
             "--start" => scenario.start_position = num(&flag, v)?,
+            "--site" => scenario.sites.push(num(&flag, v)?),
             "--duration" => duration = num(&flag, v)?,
             "--every" => {
                 let k = num(&flag, v)?;
@@ -215,6 +216,26 @@ front_angle_right_rad,rear_angle_right_rad,contact_length_left_m,contact_length_
         mx[1] * 1e-3,
         mx[1] / st[1]
     );
+    for site in sim.sites() {
+        let (mx, mn) = (site.max(), site.min());
+        // Rail seat force, bending moment (largest sagging), shear force (largest
+        // magnitude) and ballast force, per rail.
+        let side = |r: usize| {
+            format!(
+                "seat {:.1} kN, moment {:.1} kN m, shear {:.1} kN, ballast {:.1} kN",
+                mx[r][3] * 1e-3,
+                mx[r][1] * 1e-3,
+                mx[r][2].max(-mn[r][2]) * 1e-3,
+                mx[r][5] * 1e-3
+            )
+        };
+        println!(
+            "site at {:.3} m, largest: left {}; right {}",
+            site.position(),
+            side(0),
+            side(1)
+        );
+    }
     eprintln!(
         "{} steps in {:.2} s; wrote {output}",
         total,
