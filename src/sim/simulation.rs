@@ -261,6 +261,16 @@ impl Simulation {
     pub fn steps(&self) -> u64 {
         self.steps
     }
+    /// The rail under the leading wheelset's wheels `[left, right]` at `t_j`: its
+    /// displacement (m), bending moment (N m) and shear force (N)
+    /// ([`crate::track::Track::rail_response`]); `None` for the lumped track.
+    pub fn rail_under_wheels(&self) -> Option<[crate::track::RailResponse; 2]> {
+        let x = self.lead().position(self.position());
+        match &self.track {
+            TrackState::Discrete(t) => Some([0, 1].map(|rail| t.rail_response(rail, x))),
+            TrackState::Lumped(_) => None,
+        }
+    }
     /// The observation points ([`Scenario::sites`]), with what the track feels there at
     /// `t_j` and its extremes since the start.
     pub fn sites(&self) -> &[Site] {

@@ -108,6 +108,16 @@ impl FmuModel {
                 View::Sim(_, s) => s.rail_z[side],
                 View::Vehicle(_) => f64::NAN,
             },
+            Quantity::RailBendingMoment | Quantity::RailShearForce => match view {
+                View::Sim(sim, _) => sim.rail_under_wheels().map_or(f64::NAN, |r| {
+                    if q == Quantity::RailBendingMoment {
+                        r[side].bending_moment
+                    } else {
+                        r[side].shear_force
+                    }
+                }),
+                View::Vehicle(_) => f64::NAN,
+            },
             Quantity::Position => match view {
                 View::Sim(_, s) => s.position,
                 View::Vehicle(_) => f64::NAN,
