@@ -261,13 +261,13 @@ impl Simulation {
     pub fn steps(&self) -> u64 {
         self.steps
     }
-    /// The rail under the leading wheelset's wheels `[left, right]` at `t_j`: its
-    /// displacement (m), bending moment (N m) and shear force (N)
+    /// The rail `rail` (0 left, 1 right) under the leading wheelset's wheel at `t_j`:
+    /// its displacement (m), bending moment (N m) and shear force (N)
     /// ([`crate::track::Track::rail_response`]); `None` for the lumped track.
-    pub fn rail_under_wheels(&self) -> Option<[crate::track::RailResponse; 2]> {
+    pub fn rail_under_wheel(&self, rail: usize) -> Option<crate::track::RailResponse> {
         let x = self.lead().position(self.position());
         match &self.track {
-            TrackState::Discrete(t) => Some([0, 1].map(|rail| t.rail_response(rail, x))),
+            TrackState::Discrete(t) => Some(t.rail_response(rail, x)),
             TrackState::Lumped(_) => None,
         }
     }

@@ -6,6 +6,7 @@ use crate::contact::ContactState;
 use crate::fmu::vars::{QUANTITIES, Quantity};
 use crate::sim::VehicleUnit;
 use crate::sim::{Sample, Simulation, VehicleState};
+use crate::track::RailResponse;
 
 /// Values computed when the model is built, published as calculated parameters.
 #[derive(Debug, Clone, Copy, Default)]
@@ -60,6 +61,11 @@ impl FmuModel {
             View::Sim(_, s) => f(&s.contact[side]),
             View::Vehicle(_) => f64::NAN,
         };
+        // The rail under this side's wheel of a track-carrying model.
+        let rail = |f: fn(&RailResponse) -> f64| match view {
+            View::Sim(sim, _) => sim.rail_under_wheel(side).map_or(f64::NAN, |r| f(&r)),
+            View::Vehicle(_) => f64::NAN,
+        };
         // The roll-plane vehicle's displacements and bearing forces, where there is one.
         let body = |k: usize| match view {
             View::Vehicle(u) => u.displacements()[k],
@@ -108,16 +114,8 @@ impl FmuModel {
                 View::Sim(_, s) => s.rail_z[side],
                 View::Vehicle(_) => f64::NAN,
             },
-            Quantity::RailBendingMoment | Quantity::RailShearForce => match view {
-                View::Sim(sim, _) => sim.rail_under_wheels().map_or(f64::NAN, |r| {
-                    if q == Quantity::RailBendingMoment {
-                        r[side].bending_moment
-                    } else {
-                        r[side].shear_force
-                    }
-                }),
-                View::Vehicle(_) => f64::NAN,
-            },
+            Quantity::RailBendingMoment => rail(|r| r.bending_moment),
+            Quantity::RailShearForce => rail(|r| r.shear_force),
             Quantity::Position => match view {
                 View::Sim(_, s) => s.position,
                 View::Vehicle(_) => f64::NAN,

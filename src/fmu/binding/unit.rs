@@ -50,14 +50,6 @@ impl FmuModel {
         }
     }
 
-    /// The vehicle unit of RollPlaneVehicle.
-    pub fn vehicle_unit(&self) -> Option<&VehicleUnit> {
-        match &self.engine {
-            Engine::Vehicle(u) => Some(u),
-            Engine::Sim(_) => None,
-        }
-    }
-
     /// The refusal of a force `x` (N) beyond the force limit.
     #[cold]
     #[inline(never)]

@@ -244,14 +244,14 @@ fn every_output_of_every_fmu_reads_its_quantity_from_the_engine() {
     assert_eq!(real(&mut i, vr::RAIL_RIGHT_Z), s.rail_z[1]);
     assert_eq!(real(&mut i, vr::WHEEL_RIGHT_Z), s.wheel_z[1]);
     // The rail under the wheel: sagging under the static load, as the track's own.
-    let under = simulation(&i).rail_under_wheels().unwrap();
-    let m = real(&mut i, vr::RAIL_LEFT_BENDING_MOMENT);
-    assert_eq!(m, under[0].bending_moment);
-    assert!(m > 10e3 && m < 40e3, "{m}");
-    assert_eq!(
-        real(&mut i, vr::RAIL_RIGHT_SHEAR_FORCE),
-        under[1].shear_force
+    let (left, right) = (
+        simulation(&i).rail_under_wheel(0).unwrap(),
+        simulation(&i).rail_under_wheel(1).unwrap(),
     );
+    let m = real(&mut i, vr::RAIL_LEFT_BENDING_MOMENT);
+    assert_eq!(m, left.bending_moment);
+    assert!(m > 10e3 && m < 40e3, "{m}");
+    assert_eq!(real(&mut i, vr::RAIL_RIGHT_SHEAR_FORCE), right.shear_force);
     let (d, bearing) = match simulation(&i).vehicle() {
         crate::sim::VehicleState::RollPlane(v) => (*v.displacements(), v.bearing_forces()),
         _ => unreachable!("CoupledSystem carries the roll-plane vehicle"),
