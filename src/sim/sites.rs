@@ -89,13 +89,9 @@ impl Site {
 
     /// Restores the extremes from [`Site::extremes`] and reads the track now.
     pub(crate) fn restore(&mut self, track: &Track, v: &[f64]) {
-        for (k, &x) in v.iter().enumerate().take(Self::STATE_LEN) {
-            let (half, rail, q) = (k / 12, (k / 6) % 2, k % 6);
-            if half == 0 {
-                self.max[rail][q] = x;
-            } else {
-                self.min[rail][q] = x;
-            }
+        let slots = self.max.iter_mut().chain(&mut self.min).flatten();
+        for (slot, &x) in slots.zip(v) {
+            *slot = x;
         }
         self.now = Self::read(track, self.position);
     }

@@ -110,6 +110,18 @@ mod tests_support {
         p.spans = spans;
         Track::new(p, 1e-5).unwrap()
     }
+
+    /// Static stiffness of one rail seat (N/m): pad and ballast in series (the
+    /// sleeper does not roll under equal loads on both rails).
+    pub fn seat_stiffness(p: &TrackParams) -> f64 {
+        p.pad_stiffness * p.ballast_stiffness / (p.pad_stiffness + p.ballast_stiffness)
+    }
+
+    /// `beta = (k / (4 EI))^(1/4)` (1/m) of the Winkler foundation that spreads the
+    /// seats' stiffness along the rail, `k = k_s / a`.
+    pub fn winkler_beta(p: &TrackParams) -> f64 {
+        (seat_stiffness(p) / p.sleeper_spacing / (4.0 * p.rail.ei)).powf(0.25)
+    }
 }
 
 #[cfg(test)]
@@ -140,8 +152,7 @@ mod tests {
         use nalgebra::{DMatrix, DVector};
         let pr = t.params();
         let (ei, a) = (pr.rail.ei, pr.sleeper_spacing);
-        let ks =
-            pr.pad_stiffness * pr.ballast_stiffness / (pr.pad_stiffness + pr.ballast_stiffness);
+        let ks = seat_stiffness(pr);
         let n = 2 * pr.spans + 1;
         let l = a / 2.0;
         let mut k = DMatrix::<f64>::zeros(2 * n, 2 * n);
@@ -236,12 +247,7 @@ mod tests {
         }
         // A load over a sleeper bends the rail less than one between two (Zimmermann);
         // the continuous (Winkler) foundation's moment P / (4 beta) lies between.
-        let t = track(60);
-        let pr = t.params();
-        let k =
-            pr.pad_stiffness * pr.ballast_stiffness / (pr.pad_stiffness + pr.ballast_stiffness) / a;
-        let beta = (k / (4.0 * pr.rail.ei)).powf(0.25);
-        let winkler = 107_664.75 / (4.0 * beta);
+        let winkler = 107_664.75 / (4.0 * winkler_beta(track(60).params()));
         assert!(moments[0].0 < moments[1].0 && moments[0].1 < moments[1].1);
         assert!(
             moments[0].1 < winkler && winkler < moments[1].1,
@@ -309,12 +315,7 @@ mod superposition {
         );
         // It adds 3.9 % to the leading wheel's deflection; the Winkler foundation's
         // influence line `exp(-beta x) (cos beta x + sin beta x)` at 1.8 m gives 4.0 %.
-        let t = track(60);
-        let pr = t.params();
-        let k = pr.pad_stiffness * pr.ballast_stiffness
-            / (pr.pad_stiffness + pr.ballast_stiffness)
-            / pr.sleeper_spacing;
-        let bx = (k / (4.0 * pr.rail.ei)).powf(0.25) * 1.8;
+        let bx = winkler_beta(track(60).params()) * 1.8;
         let winkler = (-bx).exp() * (bx.cos() + bx.sin()) * forces[1] / forces[0];
         let added = both / alone - 1.0;
         assert!((added - winkler).abs() < 0.005, "{added} against {winkler}");
