@@ -160,6 +160,8 @@ pub const BODY_DISPLACEMENT_LIMIT: f64 = 1.0;
 pub const MAX_NODE_STEPS_PER_CALL: f64 = 5e8;
 /// Most observation points of a simulation ([`crate::sim::Site`]).
 pub const MAX_SITES: usize = 8;
+/// Most wheelsets on one track (a four-axle wagon, or two two-axle bogies).
+pub const MAX_WHEELSETS: usize = 4;
 /// The most rail segments (`track.spans * track.nodes_per_span`) a track may have: the
 /// banded static solve of 1e5 segments takes about 75 MB at its peak (740 MB at 1e6,
 /// which aborts a host short of memory), and 1e5 is 12,500 spans at the default n = 8

@@ -2,7 +2,7 @@
 //! [`crate::limits`] that no physical run passes, with the likely cause in words.
 
 use super::simulation::{Simulation, TrackState, VehicleState};
-use super::wheelset::Sample;
+use super::wheelset::{Sample, Wheelset};
 use crate::error::{Error, Result, num};
 use crate::limits::{DISPLACEMENT_LIMIT, within};
 
@@ -27,18 +27,30 @@ impl Simulation {
                 });
             }
         }
-        if let VehicleState::RollPlane(v) = &self.vehicle
-            && let Some((what, value, limit)) = v.beyond_bounds()
-        {
-            return Err(Error::Diverged {
-                what: format!("vehicle {what}"),
-                value,
-                limit,
-                time: self.time(),
-                cause: self.likely_cause(),
-            });
+        for (k, w) in self.wheelsets.iter().enumerate() {
+            if let VehicleState::RollPlane(v) = &w.vehicle
+                && let Some((what, value, limit)) = v.beyond_bounds()
+            {
+                return Err(Error::Diverged {
+                    what: format!("vehicle {what}{}", Self::of_wheelset(k)),
+                    value,
+                    limit,
+                    time: self.time(),
+                    cause: self.likely_cause(),
+                });
+            }
         }
         Ok(())
+    }
+
+    /// Where a value of wheelset `k` is named: nothing for the leading one, `" of
+    /// wheelset[k + 1]"` for the others.
+    fn of_wheelset(k: usize) -> String {
+        if k == 0 {
+            String::new()
+        } else {
+            format!(" of wheelset[{}]", k + 1)
+        }
     }
 
     /// [`Simulation::check_states`], and the sample at the current time: wheel and rail
@@ -51,35 +63,44 @@ impl Simulation {
 
     /// The sample part of [`Simulation::check_health`].
     pub fn check_sample(&self) -> Result<()> {
-        // Cheap: the sample is cached and used by the next step.
-        match self.sample_beyond_bounds(&self.sample()) {
-            Some(e) => Err(e),
-            None => Ok(()),
+        // Cheap: the samples are cached and used by the next step.
+        for k in 0..self.wheelsets.len() {
+            let w = self.wheelsets.get(k).expect("k < len");
+            let s = self.sample_of(k).expect("k < len");
+            if let Some(e) = self.sample_beyond_bounds(w, k, &s) {
+                return Err(e);
+            }
         }
+        Ok(())
     }
 
     /// The error for a wheel or rail displacement under the wheel of the latest sample
     /// beyond the bound.
     #[cold]
     #[inline(never)]
-    pub(super) fn displacement_diverged(&self) -> Error {
+    pub(super) fn displacement_diverged(&self, w: &Wheelset) -> Error {
         // The caller found one of the four displacements beyond the bound, and they
         // lead the list; the fallback is never taken.
-        let latest = &self.wheelsets.lead().latest;
-        self.sample_beyond_bounds(latest)
+        let latest = &w.latest;
+        let k = self
+            .wheelsets
+            .iter()
+            .position(|x| std::ptr::eq(x, w))
+            .unwrap_or(0);
+        self.sample_beyond_bounds(w, k, latest)
             .unwrap_or_else(|| Error::NonFinite {
                 what: "wheel or rail under the wheel".into(),
                 time: latest.time,
             })
     }
 
-    /// The first value of the leading wheelset's sample `s` (or of its force extremes)
-    /// beyond the health bounds, as the error that names it: wheel and rail under the
-    /// wheel within [`DISPLACEMENT_LIMIT`], contact forces and their extremes within the
-    /// force limit.
-    fn sample_beyond_bounds(&self, s: &Sample) -> Option<Error> {
+    /// The first value of the sample `s` of wheelset `w`, number `k` (or of its force
+    /// extremes) beyond the health bounds, as the error that names it: wheel and rail
+    /// under the wheel within [`DISPLACEMENT_LIMIT`], contact forces and their extremes
+    /// within the force limit.
+    fn sample_beyond_bounds(&self, w: &Wheelset, k: usize, s: &Sample) -> Option<Error> {
         let lim = self.force_limit;
-        let (max, min) = (self.max_force(), self.min_force());
+        let (max, min) = (w.max_force(), w.min_force());
         let values = [
             ("wheel.left.z (m)", s.wheel_z[0], DISPLACEMENT_LIMIT),
             ("wheel.right.z (m)", s.wheel_z[1], DISPLACEMENT_LIMIT),
@@ -102,7 +123,7 @@ impl Simulation {
         ];
         let (what, value, limit) = values.into_iter().find(|(_, x, l)| !within(*x, *l))?;
         Some(Error::Diverged {
-            what: what.into(),
+            what: format!("{what}{}", Self::of_wheelset(k)),
             value,
             limit,
             time: s.time,
@@ -144,7 +165,7 @@ impl Simulation {
             ),
             TrackState::Lumped(_) => "the explicit scheme diverged".into(),
         };
-        match &self.vehicle {
+        match self.vehicle() {
             VehicleState::External { wheel_z, .. } => format!(
                 "likely the wheel inputs (wheel.left.z = {} m, wheel.right.z = {} m) press \
                  the wheel into the rail far beyond a running wheel's overlap; else {step}",

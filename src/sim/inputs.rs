@@ -15,12 +15,48 @@ impl Simulation {
         self.set_rotation(gamma)
     }
 
-    /// Sets the wheel-centre displacements `[left, right]` (m) of a simulation with
-    /// [`VehicleSpec::External`](super::VehicleSpec::External) wheels. The axle rotation is not touched: it keeps
-    /// turning at `V / R_w` from the last angle given to [`Simulation::set_rotation`].
-    /// Refused for any other vehicle, and outside `|z| <=`
-    /// [`crate::limits::DISPLACEMENT_LIMIT`].
+    /// [`Simulation::set_wheel_inputs`] of wheelset `k` (0 the leading one).
+    /// Errors as there, and a wheelset the simulation does not have.
+    pub fn set_wheelset_inputs(&mut self, k: usize, z: [f64; 2], gamma: f64) -> Result<()> {
+        self.set_wheel_z_of(k, z)?;
+        self.set_rotation_of(k, gamma)
+    }
+
+    /// Sets the wheel-centre displacements of the leading wheelset
+    /// ([`Simulation::set_wheel_z_of`]).
     pub fn set_wheel_z(&mut self, z: [f64; 2]) -> Result<()> {
+        self.set_wheel_z_of(0, z)
+    }
+
+    /// Sets the axle rotation angle of the leading wheelset
+    /// ([`Simulation::set_rotation_of`]).
+    pub fn set_rotation(&mut self, gamma: f64) -> Result<()> {
+        self.set_rotation_of(0, gamma)
+    }
+
+    /// The external wheels of wheelset `k`.
+    fn external(&mut self, k: usize) -> Result<&mut VehicleState> {
+        let n = self.wheelsets.len();
+        let w = self.wheelsets.get_mut(k).ok_or_else(|| {
+            out_of_range(
+                "wheelset",
+                k as f64 + 1.0,
+                format!("1 to {n}, the wheelsets of this simulation"),
+            )
+        })?;
+        match &mut w.vehicle {
+            v @ VehicleState::External { .. } => Ok(v),
+            _ => Err(Self::not_external()),
+        }
+    }
+
+    /// Sets the wheel-centre displacements `[left, right]` (m) of wheelset `k` (0 the
+    /// leading one) of a simulation with
+    /// [`VehicleSpec::External`](super::VehicleSpec::External) wheels. The axle rotation is not touched: it keeps
+    /// turning at `V / R_w` from the last angle given to [`Simulation::set_rotation_of`].
+    /// Refused for any other vehicle, a wheelset the simulation does not have, and
+    /// outside `|z| <=` [`crate::limits::DISPLACEMENT_LIMIT`].
+    pub fn set_wheel_z_of(&mut self, k: usize, z: [f64; 2]) -> Result<()> {
         for (name, x) in [("wheel.left.z", z[0]), ("wheel.right.z", z[1])] {
             if !within(x, DISPLACEMENT_LIMIT) {
                 return Err(out_of_range(
@@ -33,33 +69,30 @@ impl Simulation {
                 ));
             }
         }
-        match &mut self.vehicle {
-            VehicleState::External { wheel_z, .. } => {
-                *wheel_z = z;
-                self.clear_cache();
-                Ok(())
-            }
-            _ => Err(Self::not_external()),
+        if let VehicleState::External { wheel_z, .. } = self.external(k)? {
+            *wheel_z = z;
         }
+        self.clear_cache();
+        Ok(())
     }
 
-    /// Sets the axle rotation angle `gamma` (rad) at the current time of a simulation
-    /// with [`VehicleSpec::External`](super::VehicleSpec::External) wheels; from now on the axle turns at `V / R_w`
-    /// from it (2.17). Refused for any other vehicle and for a non-finite angle.
-    pub fn set_rotation(&mut self, gamma: f64) -> Result<()> {
+    /// Sets the axle rotation angle `gamma` (rad) of wheelset `k` (0 the leading one)
+    /// at the current time of a simulation with
+    /// [`VehicleSpec::External`](super::VehicleSpec::External) wheels; from now on the
+    /// axle rolls without slip from it (2.17). Refused for any other vehicle, a
+    /// wheelset the simulation does not have, and a non-finite angle.
+    pub fn set_rotation_of(&mut self, k: usize, gamma: f64) -> Result<()> {
         finite("wheel.rotation", gamma, "rad")?;
         let now = self.time();
-        match &mut self.vehicle {
-            VehicleState::External {
-                rotation, since, ..
-            } => {
-                *rotation = gamma;
-                *since = now;
-                self.clear_cache();
-                Ok(())
-            }
-            _ => Err(Self::not_external()),
+        if let VehicleState::External {
+            rotation, since, ..
+        } = self.external(k)?
+        {
+            *rotation = gamma;
+            *since = now;
         }
+        self.clear_cache();
+        Ok(())
     }
 
     fn not_external() -> Error {

@@ -18,7 +18,8 @@ mod wheelset;
 
 pub use clock::StepPlan;
 pub use scenario::{
-    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, VehicleSpec, kmh,
+    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, TrackWindow,
+    TrailingWheelset, VehicleSpec, kmh,
 };
 pub use simulation::{CONTACT_STIFFNESS_MARGIN, Simulation, TrackState, VehicleState, default_dt};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};

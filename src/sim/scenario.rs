@@ -72,6 +72,48 @@ pub struct Scenario {
     /// Observation points (m along the track, at most [`crate::limits::MAX_SITES`]):
     /// what the discrete track feels there, with extremes ([`super::Site`]).
     pub sites: Vec<f64>,
+    /// The wheelsets behind the leading one (at most
+    /// [`crate::limits::MAX_WHEELSETS`] in all), each carrying the same vehicle model
+    /// as the leading one (a roll-plane vehicle, constant loads or external wheels),
+    /// with its own flats. The leading wheelset has [`Scenario::flats`].
+    pub trailing: Vec<TrailingWheelset>,
+    /// `None`: the discrete track is fixed (its `spans` from its parameters). `Some`: an
+    /// endless track, a window that moves with the wheelsets by whole sleeper spans
+    /// (its length follows from the window and the wheelsets; the track parameters'
+    /// `spans` is ignored).
+    pub window: Option<TrackWindow>,
+}
+
+/// A wheelset behind the leading one.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrailingWheelset {
+    /// Distance `d_k > 0` (m) behind the leading wheelset.
+    pub offset: f64,
+    /// Flats on the left (0) and right (1) wheel.
+    pub flats: [Vec<FlatSpec>; 2],
+}
+
+/// The window of an endless track: the lengths of track kept ahead of the leading
+/// wheelset and behind the last one. The window spans
+/// `ceil((ahead + behind + d_max) / a) + 1` sleeper spans and moves forward by whole
+/// spans whenever less than `ahead` remains in front of the leading wheelset; new track
+/// enters at rest, and the window's ends are fixed. Sleepers lie at whole multiples of
+/// the spacing `a` in line coordinates, as on a fixed track starting at 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackWindow {
+    /// Track kept ahead of the leading wheelset (m).
+    pub ahead: f64,
+    /// Track kept behind the last wheelset (m).
+    pub behind: f64,
+}
+
+impl TrackWindow {
+    /// The converged window: 6 m ahead, 6 m behind (`docs/VALIDATION.md`, the window
+    /// study).
+    pub const DEFAULT: TrackWindow = TrackWindow {
+        ahead: 6.0,
+        behind: 6.0,
+    };
 }
 
 /// Grid nodes per sleeper span used by default: the converged choice of the grid
@@ -135,6 +177,8 @@ impl Scenario {
             start_position: 2.0 * 0.685,
             dt: 0.0,
             sites: Vec::new(),
+            trailing: Vec::new(),
+            window: None,
         }
     }
 
@@ -207,6 +251,8 @@ impl Scenario {
             start_position: 2.0 * 0.6069,
             dt: 0.0,
             sites: Vec::new(),
+            trailing: Vec::new(),
+            window: None,
         }
     }
 
@@ -298,6 +344,8 @@ impl Scenario {
             start_position: 0.0,
             dt: 1e-6,
             sites: Vec::new(),
+            trailing: Vec::new(),
+            window: None,
         }
     }
 

@@ -13,11 +13,11 @@ use super::wheelset::{Sample, Wheelset, Wheelsets, contact_states, wheel_loads};
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{
-    DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, MIN_DT_FRACTION,
-    force_limit, within,
+    DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, MAX_WHEELSETS,
+    MIN_DT_FRACTION, force_limit, within,
 };
-use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, VehicleSpec};
-use crate::track::{PointLoad, SimdLevel, Track};
+use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
+use crate::track::{PointLoad, SimdLevel, Track, TrackParams};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
@@ -54,16 +54,84 @@ pub enum VehicleState {
     },
 }
 
+impl VehicleState {
+    /// Wheel-centre displacements `[left, right]` (m); `None` for constant loads (the
+    /// wheels then ride on the rail).
+    #[inline(always)]
+    fn wheel_z(&self) -> Option<[f64; 2]> {
+        match self {
+            VehicleState::RollPlane(v) => Some(v.wheel_z()),
+            VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
+            VehicleState::ConstantLoad(_) => None,
+            VehicleState::External { wheel_z, .. } => Some(*wheel_z),
+        }
+    }
+
+    /// Advances the vehicle one step under the contact forces `p` `[left, right]` (N).
+    #[inline(always)]
+    fn step(&mut self, p: [f64; 2]) {
+        match self {
+            VehicleState::RollPlane(v) => v.step(p),
+            VehicleState::LumpedWheels(v) => v.step(p),
+            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+        }
+    }
+}
+
+/// The longitudinal motion: the leading wheelset at `x = x_ref + V (t - t_ref)` (m, line
+/// coordinates) and axles that roll without slip at `gamma = gamma_ref + V (t - t_ref) /
+/// R_w` (rad), the speed `V` (m/s) held since `t_ref` (s). A new speed starts a new
+/// piece ([`Simulation::set_speed`]); a constant speed keeps `t_ref = 0`, so the position
+/// is `x_0 + V t` exactly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Motion {
+    pub(super) x_ref: f64,
+    pub(super) t_ref: f64,
+    pub(super) speed: f64,
+    pub(super) rotation_ref: f64,
+}
+
+impl Motion {
+    /// Values in the state vector.
+    pub(super) const LEN: usize = 4;
+    pub(super) fn to_array(self) -> [f64; 4] {
+        [self.x_ref, self.t_ref, self.speed, self.rotation_ref]
+    }
+    pub(super) fn from_slice(v: &[f64]) -> Motion {
+        Motion {
+            x_ref: v[0],
+            t_ref: v[1],
+            speed: v[2],
+            rotation_ref: v[3],
+        }
+    }
+}
+
+/// The window of an endless track as the simulation moves it: the track's node 0 lies
+/// at `origin_span` sleeper spans in line coordinates, and the window moves when the
+/// leading wheelset passes `shift_at` (m, track coordinates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Window {
+    pub(super) spec: TrackWindow,
+    pub(super) origin_span: i64,
+    pub(super) shift_at: f64,
+}
+
 /// A running coupled simulation: the track-carrying co-simulation unit, on the fixed
 /// grid `t_k = k dt` of its step.
 #[derive(Debug, Clone)]
 pub struct Simulation {
     pub(super) scenario: Scenario,
     pub(super) track: TrackState,
-    pub(super) vehicle: VehicleState,
-    /// The wheelsets, the leading one first (`d_1 = 0`): the one place the wheels live.
-    /// The vehicle models carry one wheelset, so there is exactly one.
+    /// The wheelsets, the leading one first (`d_1 = 0`), each with its vehicle: the one
+    /// place the wheels live.
     pub(super) wheelsets: Wheelsets,
+    pub(super) motion: Motion,
+    /// Line coordinate of the track's node 0 (m): 0 on a fixed track, whole spans on an
+    /// endless one.
+    pub(super) origin: f64,
+    /// The endless track's window; `None` on a fixed track.
+    pub(super) window: Option<Window>,
     /// The wheel loads of every wheelset passed to the track, two per wheelset.
     pub(super) loads: Vec<PointLoad>,
     pub(super) law: ContactLaw,
@@ -117,12 +185,13 @@ pub fn default_dt(scenario: &Scenario) -> f64 {
 /// Errors: track parameters [`crate::track::TrackParams::validate`] refuses; a step
 /// above the critical step ([`Error::UnstableTimeStep`]) or below [`MIN_DT_FRACTION`] of
 /// it.
-fn time_step(
+fn time_step_of(
     s: &Scenario,
+    track: &TrackSpec,
     law: &ContactLaw,
     static_load: [f64; 2],
 ) -> Result<(f64, Option<(f64, String)>)> {
-    let critical = match &s.track {
+    let critical = match track {
         TrackSpec::Discrete(p) => {
             p.validate()?;
             let perfect = WheelProfile::perfect(s.wheel_radius)?;
@@ -161,6 +230,54 @@ fn time_step(
     Ok((dt, critical))
 }
 
+/// Sleeper spacing `a` (m) of a discrete track; 1 for the lumped track.
+fn track_params_spacing(t: &TrackSpec) -> f64 {
+    match t {
+        TrackSpec::Discrete(p) => p.sleeper_spacing,
+        TrackSpec::Lumped(_) => 1.0,
+    }
+}
+
+/// Sets `p.spans` to the window `spec` around wheelsets `d_max` (m) long whose leading
+/// one starts at `x0` (m), and places the window: `ceil((ahead + behind + d_max) / a) +
+/// 1` spans, node 0 at the whole span `j = ceil((x0 - (L - ahead)) / a)`, so that at
+/// least `ahead` lies ahead of the leading wheelset and `behind` behind the last.
+///
+/// Errors: `ahead` or `behind` below one sleeper spacing or not finite; a window longer
+/// than the track may be.
+fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> Result<Window> {
+    let a = p.sleeper_spacing;
+    positive("track.sleeper_spacing", a, "m")?;
+    for (name, v) in [
+        ("track.window.ahead", spec.ahead),
+        ("track.window.behind", spec.behind),
+    ] {
+        finite(name, v, "m")?;
+        if !(v >= a && v <= MAX_WINDOW_SIDE) {
+            return Err(out_of_range(
+                name,
+                v,
+                format!(
+                    "{} m (one sleeper spacing) <= {name} <= {MAX_WINDOW_SIDE} m",
+                    num(a)
+                ),
+            ));
+        }
+    }
+    let spans = ((spec.ahead + spec.behind + d_max) / a).ceil() as usize + 1;
+    p.spans = spans;
+    let len = spans as f64 * a;
+    let j = ((x0 - (len - spec.ahead)) / a).ceil();
+    Ok(Window {
+        spec,
+        origin_span: j as i64,
+        shift_at: len - spec.ahead,
+    })
+}
+
+/// Longest window side (m) ([`TrackWindow`]).
+pub const MAX_WINDOW_SIDE: f64 = 1000.0;
+
 impl Simulation {
     /// Builds the models, checks every parameter and puts the system in static
     /// equilibrium at the start position.
@@ -180,51 +297,125 @@ impl Simulation {
         non_negative("solver.dt", s.dt, "s")?;
         non_negative("contact.Kw", s.kw, "N/m/rad")?;
         non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
+        if s.trailing.len() + 1 > MAX_WHEELSETS {
+            return Err(out_of_range(
+                "wheelsets",
+                (s.trailing.len() + 1) as f64,
+                format!("1 to {MAX_WHEELSETS} wheelsets"),
+            ));
+        }
+        for (k, w) in s.trailing.iter().enumerate() {
+            let name = format!("wheelset[{}].offset", k + 2);
+            positive(&name, w.offset, "m")?;
+            let before = if k == 0 {
+                0.0
+            } else {
+                s.trailing[k - 1].offset
+            };
+            if w.offset <= before {
+                return Err(out_of_range(
+                    &name,
+                    w.offset,
+                    format!(
+                        "> {} m, the offset of the wheelset ahead (wheelsets in order, the \
+                         leading one first)",
+                        num(before)
+                    ),
+                ));
+            }
+        }
         // The contact law first: its stiffness under the largest force a run reaches
         // enters the stability limit of the track.
         let static_load = static_loads(&s.vehicle)?;
         let law = contact_law(s, static_load)?;
-        let (dt, critical) = time_step(s, &law, static_load)?;
-        let wheelsets = Wheelsets::new(Wheelset::new(s.wheel_radius, &s.flats, 0.0)?);
-        let track = match &s.track {
+        let mut track_spec = s.track;
+        let mut window = None;
+        let d_max = s.trailing.last().map_or(0.0, |w| w.offset);
+        if let Some(spec) = s.window {
+            let TrackSpec::Discrete(p) = &mut track_spec else {
+                return Err(Error::Unsupported(
+                    "an endless track of the lumped model (it has no rails)".into(),
+                ));
+            };
+            window = Some(window_spans(p, spec, d_max, s.start_position)?);
+        }
+        let (dt, critical) = time_step_of(s, &track_spec, &law, static_load)?;
+        let vehicle = || -> Result<VehicleState> {
+            Ok(match &s.vehicle {
+                VehicleSpec::RollPlane(p) => {
+                    VehicleState::RollPlane(RollPlaneVehicle::new(*p, dt)?)
+                }
+                VehicleSpec::LumpedWheels(p) => {
+                    VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
+                }
+                VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
+                VehicleSpec::External { .. } => VehicleState::External {
+                    wheel_z: [0.0; 2],
+                    rotation: 0.0,
+                    since: 0.0,
+                },
+            })
+        };
+        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?)?;
+        let trailing = s
+            .trailing
+            .iter()
+            .map(|w| Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?))
+            .collect::<Result<Vec<_>>>()?;
+        let wheelsets = Wheelsets::new(lead, trailing);
+        let origin = window.map_or(0.0, |w: Window| {
+            w.origin_span as f64 * track_params_spacing(&track_spec)
+        });
+        let track = match &track_spec {
             TrackSpec::Discrete(p) => {
                 p.validate()?;
                 let len = p.length();
                 for w in wheelsets.iter() {
-                    let x = w.position(s.start_position);
+                    let x = w.position(s.start_position) - origin;
                     if !(x > 0.0 && x < len) {
                         return Err(out_of_range(
                             "start_position",
-                            x,
-                            format!("inside the track, 0 < x < {len} m"),
+                            s.start_position,
+                            format!(
+                                "every wheelset inside the track, 0 < x < {len} m (wheelset at \
+                                 {} m behind the leading one: {} m)",
+                                num(w.offset()),
+                                num(x)
+                            ),
                         ));
                     }
                 }
                 TrackState::Discrete(Track::new(*p, dt)?)
             }
-            TrackSpec::Lumped(p) => TrackState::Lumped(LumpedTrack::new(*p, dt)?),
-        };
-        let vehicle = match &s.vehicle {
-            VehicleSpec::RollPlane(p) => VehicleState::RollPlane(RollPlaneVehicle::new(*p, dt)?),
-            VehicleSpec::LumpedWheels(p) => VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?),
-            VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
-            VehicleSpec::External { .. } => VehicleState::External {
-                wheel_z: [0.0; 2],
-                rotation: 0.0,
-                since: 0.0,
-            },
+            TrackSpec::Lumped(p) => {
+                if wheelsets.len() > 1 {
+                    return Err(Error::Unsupported(
+                        "several wheelsets on the lumped track (one mass under one wheel)".into(),
+                    ));
+                }
+                TrackState::Lumped(LumpedTrack::new(*p, dt)?)
+            }
         };
         let load = PointLoad {
             rail: 0,
             position: 0.0,
             force: 0.0,
         };
+        let mut scenario = s.clone();
+        scenario.track = track_spec;
         let mut sim = Simulation {
-            scenario: s.clone(),
+            scenario,
             track,
-            vehicle,
             loads: vec![load; 2 * wheelsets.len()],
             wheelsets,
+            motion: Motion {
+                x_ref: s.start_position,
+                t_ref: 0.0,
+                speed: s.speed,
+                rotation_ref: 0.0,
+            },
+            origin,
+            window,
             law,
             clock: Clock::new(dt, Stepping::Grid),
             steps: 0,
@@ -238,7 +429,9 @@ impl Simulation {
         sim.check_static_sag()?;
         sim.check_states()?;
         match &sim.track {
-            TrackState::Discrete(t) => sim.sites = sites(t, &s.sites)?,
+            TrackState::Discrete(t) => {
+                sim.sites = sites(t, sim.origin, sim.window.is_some(), &s.sites)?
+            }
             TrackState::Lumped(_) if !s.sites.is_empty() => {
                 return Err(Error::Unsupported(
                     "observation points on the lumped track (it has no rails)".into(),
@@ -261,35 +454,103 @@ impl Simulation {
     pub fn steps(&self) -> u64 {
         self.steps
     }
-    /// The rail `rail` (0 left, 1 right) under the leading wheelset's wheel at `t_j`:
-    /// its displacement (m), bending moment (N m) and shear force (N)
-    /// ([`crate::track::Track::rail_response`]); `None` for the lumped track.
-    pub fn rail_under_wheel(&self, rail: usize) -> Option<crate::track::RailResponse> {
-        let x = self.lead().position(self.position());
+    /// The rail `rail` (0 left, 1 right) under the wheel of wheelset `k` (0 the leading
+    /// one) at `t_j`: its displacement (m), bending moment (N m) and shear force (N)
+    /// ([`crate::track::Track::rail_response`]); `None` for the lumped track or a
+    /// wheelset `k` the simulation does not have.
+    pub fn rail_under_wheel_of(&self, k: usize, rail: usize) -> Option<crate::track::RailResponse> {
+        let w = self.wheelsets.get(k)?;
+        let x = w.position(self.position()) - self.origin;
         match &self.track {
             TrackState::Discrete(t) => Some(t.rail_response(rail, x)),
             TrackState::Lumped(_) => None,
         }
+    }
+    /// [`Simulation::rail_under_wheel_of`] the leading wheelset.
+    pub fn rail_under_wheel(&self, rail: usize) -> Option<crate::track::RailResponse> {
+        self.rail_under_wheel_of(0, rail)
     }
     /// The observation points ([`Scenario::sites`]), with what the track feels there at
     /// `t_j` and its extremes since the start.
     pub fn sites(&self) -> &[Site] {
         &self.sites
     }
-    /// Position of the leading wheelset at the current time (m): `x_0 + V t`.
+    /// Position of the leading wheelset at the current time (m, line coordinates):
+    /// `x_0 + V t` at constant speed, the integral of the speed in general
+    /// ([`Simulation::set_speed`]).
+    #[inline(always)]
     pub fn position(&self) -> f64 {
-        self.scenario.start_position + self.scenario.speed * self.time()
+        let m = &self.motion;
+        m.x_ref + m.speed * (self.time() - m.t_ref)
     }
-    /// Axle rotation angle at the current time (rad) (2.17).
-    pub fn rotation(&self) -> f64 {
-        match &self.vehicle {
+    /// Forward speed (m/s) from now on.
+    pub fn speed(&self) -> f64 {
+        self.motion.speed
+    }
+    /// Line coordinate of the track's left end (m): 0 on a fixed track; on an endless
+    /// track, where the window begins now.
+    pub fn track_origin(&self) -> f64 {
+        self.origin
+    }
+    /// The endless track's window, `None` on a fixed track.
+    pub fn window(&self) -> Option<TrackWindow> {
+        self.window.map(|w| w.spec)
+    }
+    /// Axle rotation angle of the axles that roll without slip at the current time
+    /// (rad) (2.17): the leading wheelset's, unless its rotation is an input.
+    #[inline(always)]
+    fn rolling_rotation(&self) -> f64 {
+        let m = &self.motion;
+        m.rotation_ref + m.speed * (self.time() - m.t_ref) / self.scenario.wheel_radius
+    }
+    /// Axle rotation angle of wheelset `w` at the current time (rad) (2.17).
+    #[inline(always)]
+    fn rotation_of(&self, w: &Wheelset) -> f64 {
+        match &w.vehicle {
             VehicleState::External {
                 rotation, since, ..
-            } => {
-                *rotation + self.scenario.speed * (self.time() - since) / self.scenario.wheel_radius
-            }
-            _ => self.scenario.speed * self.time() / self.scenario.wheel_radius,
+            } => *rotation + self.motion.speed * (self.time() - since) / self.scenario.wheel_radius,
+            _ => self.rolling_rotation(),
         }
+    }
+    /// Axle rotation angle of the leading wheelset at the current time (rad) (2.17).
+    pub fn rotation(&self) -> f64 {
+        self.rotation_of(self.lead())
+    }
+
+    /// Changes the forward speed to `v` (m/s) from the current time: the position and
+    /// the rolling axles integrate the speed held over each step (the master's
+    /// zero-order hold). Standstill (`v = 0`) is allowed; a speed at which a fixed
+    /// track would end within the current step is refused at the next step
+    /// ([`Error::OffTrack`]).
+    ///
+    /// Errors: `v` not finite or outside 0 to 200 m/s (named `speed`).
+    pub fn set_speed(&mut self, v: f64) -> Result<()> {
+        crate::limits::check("speed", v)?;
+        if v == self.motion.speed {
+            return Ok(());
+        }
+        let now = self.time();
+        let (x, gamma) = (self.position(), self.rolling_rotation());
+        let speed = self.motion.speed;
+        let radius = self.scenario.wheel_radius;
+        for w in self.wheelsets.iter_mut() {
+            if let VehicleState::External {
+                rotation, since, ..
+            } = &mut w.vehicle
+            {
+                *rotation += speed * (now - *since) / radius;
+                *since = now;
+            }
+        }
+        self.motion = Motion {
+            x_ref: x,
+            t_ref: now,
+            speed: v,
+            rotation_ref: gamma,
+        };
+        self.clear_cache();
+        Ok(())
     }
 
     /// Rail nodes of the discrete track, both rails (the work of one track step scales
@@ -301,13 +562,14 @@ impl Simulation {
         }
     }
 
-    /// Time (s) at which the leading wheelset reaches the end of the discrete track,
-    /// from the start; `None` for the lumped track or at speed 0.
+    /// Time (s) at which the leading wheelset reaches the end of a fixed discrete
+    /// track at the current speed; `None` for the lumped track, an endless track or
+    /// at standstill.
     pub fn time_at_track_end(&self) -> Option<f64> {
-        let s = &self.scenario;
+        let v = self.motion.speed;
         match &self.track {
-            TrackState::Discrete(t) if s.speed > 0.0 => {
-                Some((t.params().length() - s.start_position) / s.speed)
+            TrackState::Discrete(t) if v > 0.0 && self.window.is_none() => {
+                Some(self.time() + (t.params().length() - (self.position() - self.origin)) / v)
             }
             _ => None,
         }
@@ -346,11 +608,11 @@ impl Simulation {
     pub fn track(&self) -> &TrackState {
         &self.track
     }
-    /// Vehicle state.
+    /// The leading wheelset's vehicle.
     pub fn vehicle(&self) -> &VehicleState {
-        &self.vehicle
+        &self.lead().vehicle
     }
-    /// The scenario.
+    /// The scenario (on an endless track, with the window's spans).
     pub fn scenario(&self) -> &Scenario {
         &self.scenario
     }
@@ -367,22 +629,27 @@ impl Simulation {
         self.wheelsets.clear_cache();
     }
 
-    /// Wheel-centre displacements `[left, right]` (m).
+    /// Wheel-centre displacements `[left, right]` (m) of the leading wheelset.
     pub fn wheel_z(&self) -> [f64; 2] {
-        match &self.vehicle {
-            VehicleState::RollPlane(v) => v.wheel_z(),
-            VehicleState::LumpedWheels(v) => v.wheel_z(),
-            VehicleState::ConstantLoad(_) => self.rail_z(),
-            VehicleState::External { wheel_z, .. } => *wheel_z,
+        self.wheel_z_of(self.lead())
+    }
+
+    /// Wheel-centre displacements `[left, right]` (m) of wheelset `w` (on the rails
+    /// under constant loads).
+    #[inline(always)]
+    fn wheel_z_of(&self, w: &Wheelset) -> [f64; 2] {
+        match w.vehicle.wheel_z() {
+            Some(z) => z,
+            None => self.rail_z_under(w.position(self.position()) - self.origin),
         }
     }
 
     /// Rail displacements under the wheels of the leading wheelset (m) (3.23).
     pub fn rail_z(&self) -> [f64; 2] {
-        self.rail_z_under(self.lead().position(self.position()))
+        self.rail_z_under(self.lead().position(self.position()) - self.origin)
     }
 
-    /// Rail displacements (m) under wheels at position `x` (m).
+    /// Rail displacements (m) under wheels at track position `x` (m).
     #[inline(always)]
     fn rail_z_under(&self, x: f64) -> [f64; 2] {
         match &self.track {
@@ -394,48 +661,55 @@ impl Simulation {
     /// Everything at the current time for the leading wheelset, contact forces
     /// included.
     pub fn sample(&self) -> Sample {
-        if let Some(s) = self.lead().cached.get() {
+        self.sample_of_wheelset(self.lead())
+    }
+
+    /// Everything at the current time for wheelset `k` (0 the leading one), contact
+    /// forces included; `None` for a wheelset the simulation does not have.
+    pub fn sample_of(&self, k: usize) -> Option<Sample> {
+        Some(self.sample_of_wheelset(self.wheelsets.get(k)?))
+    }
+
+    fn sample_of_wheelset(&self, w: &Wheelset) -> Sample {
+        if let Some(s) = w.cached.get() {
             return s;
         }
-        let s = self.compute_sample_dispatched();
-        self.lead().cached.set(Some(s));
-        s
-    }
-
-    // `compute_sample` compiled for the SIMD level, as in `step` (a co-simulation master
-    // reads the outputs before it steps, so this is where its contact forces are
-    // computed).
-    fn compute_sample_dispatched(&self) -> Sample {
-        at_level(
+        // `compute_sample` compiled for the SIMD level, as in `step` (a co-simulation
+        // master reads the outputs before it steps, so this is where its contact
+        // forces are computed).
+        let s = at_level(
             self.simd,
             #[inline(always)]
-            || self.compute_sample(),
-        )
-    }
-
-    #[inline(always)]
-    fn compute_sample(&self) -> Sample {
-        let mut s = Sample::default();
-        (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = self.sample_head();
-        contact_states(&self.vehicle, &self.law, self.lead().wheels(), &mut s);
+            || self.compute_sample(w),
+        );
+        w.cached.set(Some(s));
         s
     }
 
-    /// Everything of the leading wheelset's sample at the current time but the contact
-    /// states: time (s), position (m), axle rotation (rad), wheel and rail displacements
-    /// (m).
     #[inline(always)]
-    fn sample_head(&self) -> (f64, f64, f64, [f64; 2], [f64; 2]) {
+    fn compute_sample(&self, w: &Wheelset) -> Sample {
+        let mut s = Sample::default();
+        (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = self.sample_head(w);
+        contact_states(&w.vehicle, &self.law, w.wheels(), &mut s);
+        s
+    }
+
+    /// Everything of wheelset `w`'s sample at the current time but the contact states:
+    /// time (s), position (m, line coordinates), axle rotation (rad), wheel and rail
+    /// displacements (m).
+    #[inline(always)]
+    fn sample_head(&self, w: &Wheelset) -> (f64, f64, f64, [f64; 2], [f64; 2]) {
         let time = self.time();
-        let x = self.scenario.start_position + self.scenario.speed * time;
-        let position = self.lead().position(x);
-        let (rotation, wheel_z) = (self.rotation(), self.wheel_z());
+        let m = &self.motion;
+        let x = m.x_ref + m.speed * (time - m.t_ref);
+        let position = w.position(x);
+        let (rotation, wheel_z) = (self.rotation_of(w), self.wheel_z_of(w));
         (
             time,
             position,
             rotation,
             wheel_z,
-            self.rail_z_under(position),
+            self.rail_z_under(position - self.origin),
         )
     }
 
@@ -486,7 +760,8 @@ impl Simulation {
         let x = self.position();
         if let TrackState::Discrete(t) = &self.track {
             let len = t.params().length();
-            if !(x > 0.0 && x < len) {
+            let xt = x - self.origin;
+            if !(xt > 0.0 && xt < len) {
                 return Err(Error::OffTrack {
                     position: x,
                     length: len,
@@ -501,36 +776,57 @@ impl Simulation {
         if let Some(s) = self.wheelsets.lead().cached.take() {
             self.wheelsets.lead_mut().latest = s;
         } else {
-            let head = self.sample_head();
-            let (wheels, s) = self.wheelsets.lead_mut().parts_mut();
+            let head = self.sample_head(self.lead());
+            let (wheels, vehicle, s) = self.wheelsets.lead_mut().parts_mut();
             (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
-            contact_states(&self.vehicle, &self.law, wheels, s);
+            contact_states(vehicle, &self.law, wheels, s);
         }
-        let s = &self.lead().latest;
-        let (zw, zr) = (s.wheel_z, s.rail_z);
-        if !(within(zw[0], DISPLACEMENT_LIMIT)
-            && within(zw[1], DISPLACEMENT_LIMIT)
-            && within(zr[0], DISPLACEMENT_LIMIT)
-            && within(zr[1], DISPLACEMENT_LIMIT))
-        {
-            return Err(self.displacement_diverged());
+        if !self.wheelsets.trailing().is_empty() {
+            self.sample_trailing();
         }
-        self.advance_with(x, s.time)?;
+        for w in self.wheelsets.iter() {
+            let s = &w.latest;
+            let (zw, zr) = (s.wheel_z, s.rail_z);
+            if !(within(zw[0], DISPLACEMENT_LIMIT)
+                && within(zw[1], DISPLACEMENT_LIMIT)
+                && within(zr[0], DISPLACEMENT_LIMIT)
+                && within(zr[1], DISPLACEMENT_LIMIT))
+            {
+                return Err(self.displacement_diverged(w));
+            }
+        }
+        let time = self.lead().latest.time;
+        self.advance_with(x, time)?;
         if self.steps.is_multiple_of(HEALTH_CHECK_INTERVAL) {
             self.check_states()?;
         }
         Ok(self.lead().latest)
     }
 
-    /// Advances `n` steps of [`Simulation::dt`]. A run whose end would carry the wheel
-    /// off the track is refused with [`Error::OffTrack`] before anything moves; a
-    /// value beyond the health bounds stops it with [`Error::Diverged`].
+    /// The samples at `t_j` of the wheelsets behind the leading one, in place.
+    #[inline(never)]
+    fn sample_trailing(&mut self) {
+        for k in 0..self.wheelsets.trailing().len() {
+            let w = &self.wheelsets.trailing()[k];
+            let sample = match w.cached.take() {
+                Some(s) => s,
+                None => self.compute_sample(w),
+            };
+            self.wheelsets.trailing_mut()[k].latest = sample;
+        }
+    }
+
+    /// Advances `n` steps of [`Simulation::dt`]. A run whose end would carry the
+    /// leading wheelset off a fixed track is refused with [`Error::OffTrack`] before
+    /// anything moves (an endless track has no end); a value beyond the health bounds
+    /// stops it with [`Error::Diverged`].
     pub fn advance_steps(&mut self, n: u64) -> Result<()> {
-        if let TrackState::Discrete(t) = &self.track {
+        if let (TrackState::Discrete(t), None) = (&self.track, &self.window) {
             let len = t.params().length();
             let t_end = self.clock.time_after(n);
-            let end = self.scenario.start_position + self.scenario.speed * t_end;
-            if !(end > 0.0 && end < len) {
+            let m = &self.motion;
+            let end = m.x_ref + m.speed * (t_end - m.t_ref);
+            if !(end - self.origin > 0.0 && end - self.origin < len) {
                 return Err(Error::OffTrack {
                     position: end,
                     length: len,
@@ -590,34 +886,66 @@ impl Simulation {
     }
 
     /// Advances vehicle and track from `t_j` (s) with the contact forces of the
-    /// wheelsets' samples at `t_j`, the leading wheelset at position `x` (m).
+    /// wheelsets' samples at `t_j`, the leading wheelset at position `x` (m, line
+    /// coordinates); then moves an endless track's window if the leading wheelset has
+    /// passed its mark.
     #[inline(always)]
     fn advance_with(&mut self, x: f64, time: f64) -> Result<()> {
-        let p = self.lead().forces();
         let lim = self.force_limit;
-        if !(within(p[0], lim) && within(p[1], lim)) {
-            return Err(self.force_diverged(p, time));
+        for w in self.wheelsets.iter() {
+            let p = w.forces();
+            if !(within(p[0], lim) && within(p[1], lim)) {
+                return Err(self.force_diverged(p, time));
+            }
         }
-        self.wheelsets.lead_mut().extremes.record(p);
-        match &mut self.vehicle {
-            VehicleState::RollPlane(v) => v.step(p),
-            VehicleState::LumpedWheels(v) => v.step(p),
-            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+        for w in self.wheelsets.iter_mut() {
+            let p = w.forces();
+            w.extremes.record(p);
+            w.vehicle.step(p);
         }
         match &mut self.track {
             TrackState::Discrete(t) => {
-                wheel_loads(x, &self.wheelsets, Wheelset::forces, &mut self.loads);
+                wheel_loads(
+                    x - self.origin,
+                    &self.wheelsets,
+                    Wheelset::forces,
+                    &mut self.loads,
+                );
                 t.step(&self.loads);
                 if !self.sites.is_empty() {
                     for site in &mut self.sites {
-                        site.record(t);
+                        site.record(t, self.origin);
                     }
                 }
             }
-            TrackState::Lumped(t) => t.step(p),
+            TrackState::Lumped(t) => t.step(self.wheelsets.lead().forces()),
         }
         self.steps += 1;
         self.clock.tick();
+        if let Some(w) = &self.window
+            && self.position() - self.origin > w.shift_at
+        {
+            self.move_window()?;
+        }
+        Ok(())
+    }
+
+    /// Moves the endless track's window forward by the whole spans that put the
+    /// leading wheelset back within `ahead` of the window's end.
+    #[cold]
+    #[inline(never)]
+    fn move_window(&mut self) -> Result<()> {
+        let (Some(w), TrackState::Discrete(t)) = (&mut self.window, &mut self.track) else {
+            return Ok(());
+        };
+        let a = t.params().sleeper_spacing;
+        let x = self.motion.x_ref + self.motion.speed * (self.clock.time() - self.motion.t_ref);
+        let beyond = x - self.origin - w.shift_at;
+        let m = ((beyond / a).floor() as usize + 1).min(t.params().spans - 1);
+        t.shift_spans(m)?;
+        w.origin_span += m as i64;
+        self.origin = w.origin_span as f64 * a;
+        self.clear_cache();
         Ok(())
     }
 
@@ -637,13 +965,15 @@ impl Simulation {
                 ));
             }
         }
-        match &mut self.vehicle {
-            VehicleState::RollPlane(v) => v.change_dt(dt)?,
-            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
-            VehicleState::LumpedWheels(_) => {
-                return Err(Error::Unsupported(
-                    "changing the step of the lumped wheels".into(),
-                ));
+        for w in self.wheelsets.iter_mut() {
+            match &mut w.vehicle {
+                VehicleState::RollPlane(v) => v.change_dt(dt)?,
+                VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+                VehicleState::LumpedWheels(_) => {
+                    return Err(Error::Unsupported(
+                        "changing the step of the lumped wheels".into(),
+                    ));
+                }
             }
         }
         self.clock.restart(dt);

@@ -51,8 +51,14 @@ impl Site {
         &self.min
     }
 
-    /// What `track` feels at `x` (m) now.
-    fn read(track: &Track, x: f64) -> SiteValues {
+    /// What `track`, whose node 0 lies at `origin` (m), feels at `x` (m, line
+    /// coordinates) now; zeros (the track at rest) outside the track: an endless
+    /// track's window has not reached the site yet, or has left it behind.
+    fn read(track: &Track, origin: f64, x: f64) -> SiteValues {
+        let x = x - origin;
+        if !(x > 0.0 && x < track.params().length()) {
+            return [[0.0; 6]; 2];
+        }
         [0, 1].map(|rail| {
             let r = track.rail_response(rail, x);
             let s = track.support_response(rail, x);
@@ -68,8 +74,8 @@ impl Site {
     }
 
     /// Reads the track now and takes the values into the extremes.
-    pub(crate) fn record(&mut self, track: &Track) {
-        self.now = Self::read(track, self.position);
+    pub(crate) fn record(&mut self, track: &Track, origin: f64) {
+        self.now = Self::read(track, origin, self.position);
         for rail in 0..2 {
             for q in 0..6 {
                 let x = self.now[rail][q];
@@ -88,20 +94,26 @@ impl Site {
     pub(crate) const STATE_LEN: usize = 24;
 
     /// Restores the extremes from [`Site::extremes`] and reads the track now.
-    pub(crate) fn restore(&mut self, track: &Track, v: &[f64]) {
+    pub(crate) fn restore(&mut self, track: &Track, origin: f64, v: &[f64]) {
         let slots = self.max.iter_mut().chain(&mut self.min).flatten();
         for (slot, &x) in slots.zip(v) {
             *slot = x;
         }
-        self.now = Self::read(track, self.position);
+        self.now = Self::read(track, origin, self.position);
     }
 }
 
-/// The observation points at `positions` (m) on `track`, their extremes started at the
-/// track's current state.
+/// The observation points at `positions` (m, line coordinates) on `track`, whose node 0
+/// lies at `origin` (m), their extremes started at the track's current state.
 ///
-/// Errors: more than [`MAX_SITES`] points, or a point outside the track.
-pub(crate) fn sites(track: &Track, positions: &[f64]) -> Result<Vec<Site>> {
+/// Errors: more than [`MAX_SITES`] points; a point outside a fixed track (`endless`
+/// false), or not finite.
+pub(crate) fn sites(
+    track: &Track,
+    origin: f64,
+    endless: bool,
+    positions: &[f64],
+) -> Result<Vec<Site>> {
     if positions.len() > MAX_SITES {
         return Err(out_of_range(
             "sites",
@@ -113,14 +125,16 @@ pub(crate) fn sites(track: &Track, positions: &[f64]) -> Result<Vec<Site>> {
     positions
         .iter()
         .map(|&x| {
-            if !(x > 0.0 && x < len) {
+            if endless {
+                crate::error::finite("site position", x, "m")?;
+            } else if !(x > 0.0 && x < len) {
                 return Err(out_of_range(
                     "site position",
                     x,
                     format!("0 m < site position < {len} m (the track)"),
                 ));
             }
-            let now = Site::read(track, x);
+            let now = Site::read(track, origin, x);
             Ok(Site {
                 position: x,
                 now,

@@ -1,8 +1,9 @@
 //! The state vector of a simulation: everything that determines the continuation, so
 //! that a saved run continues bit for bit (FMU states).
 
+use super::TrackSpec;
 use super::clock::ForceExtremes;
-use super::simulation::{Simulation, TrackState, VehicleState};
+use super::simulation::{Motion, Simulation, TrackState, VehicleState};
 use super::sites::Site;
 use crate::error::{Error, Result, num, out_of_range};
 use crate::limits::MIN_DT_FRACTION;
@@ -14,10 +15,13 @@ const CLOCK: usize = 4;
 impl Simulation {
     /// Everything that determines the continuation: the clock (step (s), `t0` (s),
     /// steps since `t0`, steps since the start), the force extremes of every wheelset
-    /// (`[max left, max right, min left, min right]` (N)), the track's state, then the
-    /// vehicle's (the roll-plane vehicle's step and displacements, or the external
-    /// wheels' inputs: `z` `[left, right]` (m), the axle angle (rad) and the time (s)
-    /// it was given at). [`Simulation::set_state_vector`] restores it exactly.
+    /// (`[max left, max right, min left, min right]` (N)), the sites' extremes, the
+    /// track's state, then each wheelset's vehicle's (the roll-plane vehicle's step
+    /// and displacements, or the external wheels' inputs: `z` `[left, right]` (m), the
+    /// axle angle (rad) and the time (s) it was given at), the motion (position (m)
+    /// and time (s) of the speed's last change, the speed (m/s), the rolling axles'
+    /// angle then (rad)) and the endless track's window (its first node, in whole
+    /// sleeper spans; 0 on a fixed track). [`Simulation::set_state_vector`] restores it exactly.
     ///
     /// Errors: a lumped track or lumped wheels ([`Error::Unsupported`]); only the
     /// discrete track with the roll-plane vehicle, constant loads or external wheels
@@ -35,13 +39,17 @@ impl Simulation {
             TrackState::Discrete(t) => v.extend(t.state_vector()),
             TrackState::Lumped(_) => return Err(Self::no_state()),
         }
-        v.extend(self.vehicle_state()?);
+        for w in self.wheelsets.iter() {
+            v.extend(Self::vehicle_state(&w.vehicle)?);
+        }
+        v.extend(self.motion.to_array());
+        v.push(self.window.map_or(0.0, |w| w.origin_span as f64));
         Ok(v)
     }
 
-    /// The vehicle's part of [`Simulation::state_vector`].
-    fn vehicle_state(&self) -> Result<Vec<f64>> {
-        Ok(match &self.vehicle {
+    /// One wheelset's vehicle's part of [`Simulation::state_vector`].
+    fn vehicle_state(vehicle: &VehicleState) -> Result<Vec<f64>> {
+        Ok(match vehicle {
             VehicleState::RollPlane(r) => r.state_vector(),
             VehicleState::ConstantLoad(_) => Vec::new(),
             VehicleState::External {
@@ -89,32 +97,54 @@ impl Simulation {
             TrackState::Discrete(t) => t.state_len(),
             TrackState::Lumped(_) => return Err(Self::no_state()),
         };
-        let nv = self.vehicle_state()?.len();
+        let nv = Self::vehicle_state(&self.wheelsets.lead().vehicle)?.len();
+        let nw = self.wheelsets.len();
         let extremes_end = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
         let head = extremes_end + Site::STATE_LEN * self.sites.len();
-        if v.len() != head + nt + nv {
+        let total = head + nt + nw * nv + Motion::LEN + 1;
+        if v.len() != total {
             return Err(out_of_range(
                 "simulation state length",
                 v.len() as f64,
-                format!("{} values for this scenario", head + nt + nv),
+                format!("{total} values for this scenario"),
+            ));
+        }
+        let tail = &v[total - Motion::LEN - 1..];
+        let origin_span = tail[Motion::LEN];
+        if !(tail.iter().all(|x| x.is_finite())
+            && tail[2] >= 0.0
+            && origin_span.fract() == 0.0
+            && origin_span.abs() < 2f64.powi(53))
+        {
+            return Err(out_of_range(
+                "state: motion",
+                tail[2],
+                "position, time, speed >= 0 m/s, rotation finite; window origin a whole number",
             ));
         }
         if let TrackState::Discrete(t) = &mut self.track {
             t.set_state_vector(&v[head..head + nt])?;
         }
-        let e = &v[head + nt..];
-        match &mut self.vehicle {
-            VehicleState::RollPlane(r) => r.set_state_vector(e)?,
-            VehicleState::External {
-                wheel_z,
-                rotation,
-                since,
-            } => {
-                *wheel_z = [e[0], e[1]];
-                *rotation = e[2];
-                *since = e[3];
+        let vehicles = v[head + nt..head + nt + nw * nv].chunks_exact(nv.max(1));
+        for (w, e) in self.wheelsets.iter_mut().zip(vehicles) {
+            match &mut w.vehicle {
+                VehicleState::RollPlane(r) => r.set_state_vector(e)?,
+                VehicleState::External {
+                    wheel_z,
+                    rotation,
+                    since,
+                } => {
+                    *wheel_z = [e[0], e[1]];
+                    *rotation = e[2];
+                    *since = e[3];
+                }
+                _ => {}
             }
-            _ => {}
+        }
+        self.motion = Motion::from_slice(tail);
+        if let (Some(w), TrackSpec::Discrete(p)) = (&mut self.window, &self.scenario.track) {
+            w.origin_span = origin_span as i64;
+            self.origin = w.origin_span as f64 * p.sleeper_spacing;
         }
         let c = &mut self.clock;
         (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);
@@ -126,7 +156,7 @@ impl Simulation {
         if let TrackState::Discrete(t) = &self.track {
             let stored = v[extremes_end..head].chunks_exact(Site::STATE_LEN);
             for (site, x) in self.sites.iter_mut().zip(stored) {
-                site.restore(t, x);
+                site.restore(t, self.origin, x);
             }
         }
         self.clear_cache();

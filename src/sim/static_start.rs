@@ -81,28 +81,30 @@ impl Simulation {
     /// on those wheel heights.
     pub(crate) fn set_static(&mut self) -> Result<()> {
         self.clear_cache();
-        let x = self.scenario.start_position;
+        let x = self.position() - self.origin;
         let p = self.static_load;
-        let w = self.wheelsets.lead();
-        let xw = w.position(x);
-        let zr = match &mut self.track {
+        match &mut self.track {
             TrackState::Discrete(t) => {
                 wheel_loads(x, &self.wheelsets, |_| p, &mut self.loads);
                 t.set_static(&self.loads)?;
-                [t.rail_z_at(0, xw), t.rail_z_at(1, xw)]
             }
-            TrackState::Lumped(t) => {
-                t.set_static(p);
-                t.rail_z()
+            TrackState::Lumped(t) => t.set_static(p),
+        }
+        for k in 0..self.wheelsets.len() {
+            let w = self.wheelsets.get(k).expect("k < len");
+            let xw = w.position(x);
+            let zr = match &self.track {
+                TrackState::Discrete(t) => [t.rail_z_at(0, xw), t.rail_z_at(1, xw)],
+                TrackState::Lumped(t) => t.rail_z(),
+            };
+            let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));
+            let zw = [zr[0] - delta[0], zr[1] - delta[1]];
+            match &mut self.wheelsets.get_mut(k).expect("k < len").vehicle {
+                VehicleState::RollPlane(v) => v.set_static(zw)?,
+                VehicleState::LumpedWheels(v) => v.set_static(zw),
+                VehicleState::ConstantLoad(_) => {}
+                VehicleState::External { wheel_z, .. } => *wheel_z = zw,
             }
-        };
-        let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));
-        let zw = [zr[0] - delta[0], zr[1] - delta[1]];
-        match &mut self.vehicle {
-            VehicleState::RollPlane(v) => v.set_static(zw)?,
-            VehicleState::LumpedWheels(v) => v.set_static(zw),
-            VehicleState::ConstantLoad(_) => {}
-            VehicleState::External { wheel_z, .. } => *wheel_z = zw,
         }
         Ok(())
     }

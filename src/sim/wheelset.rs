@@ -28,11 +28,14 @@ pub struct Sample {
 
 /// One wheelset on the track: its left and right wheel (nominal radius `R_w` and
 /// flats, 2.9-2.21), its distance `d_k >= 0` (m) behind the leading wheelset (it runs at
-/// `x_k = x_1 - d_k`), its contact states and the extremes of its contact forces.
+/// `x_k = x_1 - d_k`), what moves its wheels (its vehicle: a roll-plane vehicle, lumped
+/// wheels, constant loads or external inputs), its contact states and the extremes of
+/// its contact forces.
 #[derive(Debug, Clone)]
 pub struct Wheelset {
     wheels: [WheelProfile; 2],
     offset: f64,
+    pub(crate) vehicle: VehicleState,
     pub(crate) extremes: ForceExtremes,
     // The sample of the latest step, contact states included, built here in place by
     // `Simulation::step` (a sample built in a temporary and copied at once stalled the
@@ -45,11 +48,16 @@ pub struct Wheelset {
 
 impl Wheelset {
     /// A wheelset `offset` (m) behind the leading one whose wheels have the nominal
-    /// radius `radius` (m) and the flats `flats` `[left, right]`.
+    /// radius `radius` (m) and the flats `flats` `[left, right]`, moved by `vehicle`.
     ///
     /// Errors: `offset` negative or not finite; a radius or flat that
     /// [`WheelProfile::new`] refuses (named `flat.left` or `flat.right`).
-    pub fn new(radius: f64, flats: &[Vec<FlatSpec>; 2], offset: f64) -> Result<Wheelset> {
+    pub fn new(
+        radius: f64,
+        flats: &[Vec<FlatSpec>; 2],
+        offset: f64,
+        vehicle: VehicleState,
+    ) -> Result<Wheelset> {
         non_negative("wheelset.offset", offset, "m")?;
         Ok(Wheelset {
             wheels: [
@@ -57,6 +65,7 @@ impl Wheelset {
                 WheelProfile::new(radius, &flats[1], "flat.right")?,
             ],
             offset,
+            vehicle,
             extremes: ForceExtremes::NONE,
             latest: Sample::default(),
             cached: Cell::new(None),
@@ -66,6 +75,14 @@ impl Wheelset {
     /// The wheels `[left, right]`.
     pub fn wheels(&self) -> &[WheelProfile; 2] {
         &self.wheels
+    }
+    /// What moves the wheels.
+    pub fn vehicle(&self) -> &VehicleState {
+        &self.vehicle
+    }
+    /// The latest sample, of the step last taken.
+    pub fn latest(&self) -> &Sample {
+        &self.latest
     }
     /// Distance `d_k` behind the leading wheelset (m).
     pub fn offset(&self) -> f64 {
@@ -86,10 +103,10 @@ impl Wheelset {
     pub fn min_force(&self) -> [f64; 2] {
         self.extremes.min
     }
-    /// The wheels and the latest sample, to build the sample in place.
+    /// The wheels, the vehicle and the latest sample, to build the sample in place.
     #[inline(always)]
-    pub(crate) fn parts_mut(&mut self) -> (&[WheelProfile; 2], &mut Sample) {
-        (&self.wheels, &mut self.latest)
+    pub(crate) fn parts_mut(&mut self) -> (&[WheelProfile; 2], &VehicleState, &mut Sample) {
+        (&self.wheels, &self.vehicle, &mut self.latest)
     }
     /// The contact forces `[left, right]` (N) of the latest step.
     #[inline(always)]
@@ -110,12 +127,35 @@ pub struct Wheelsets {
 }
 
 impl Wheelsets {
-    /// The list of one wheelset, `lead`.
-    pub(crate) fn new(lead: Wheelset) -> Wheelsets {
-        Wheelsets {
-            lead,
-            trailing: Vec::new(),
+    /// The list of `lead` followed by `trailing`.
+    pub(crate) fn new(lead: Wheelset, trailing: Vec<Wheelset>) -> Wheelsets {
+        Wheelsets { lead, trailing }
+    }
+    /// Wheelset `k`, the leading one 0.
+    pub fn get(&self, k: usize) -> Option<&Wheelset> {
+        match k {
+            0 => Some(&self.lead),
+            _ => self.trailing.get(k - 1),
         }
+    }
+    pub(crate) fn get_mut(&mut self, k: usize) -> Option<&mut Wheelset> {
+        match k {
+            0 => Some(&mut self.lead),
+            _ => self.trailing.get_mut(k - 1),
+        }
+    }
+    /// The wheelsets behind the leading one.
+    #[inline(always)]
+    pub fn trailing(&self) -> &[Wheelset] {
+        &self.trailing
+    }
+    #[inline(always)]
+    pub(crate) fn trailing_mut(&mut self) -> &mut [Wheelset] {
+        &mut self.trailing
+    }
+    /// The distance from the leading wheelset to the last one (m).
+    pub fn length(&self) -> f64 {
+        self.iter().map(|w| w.offset).fold(0.0, f64::max)
     }
     /// Number of wheelsets (at least 1).
     pub fn len(&self) -> usize {
@@ -153,8 +193,8 @@ impl Wheelsets {
 }
 
 /// The loads of every wheelset on the rails, written into `loads`, two per wheelset
-/// (left rail, then right) in the order of the list: wheelset k, at `x - d_k` (m) when
-/// the leading one is at `x`, pushes each rail down with its wheel's force of
+/// (left rail, then right) in the order of the list: wheelset k, at `x - d_k` (m, in
+/// the track's coordinates) when the leading one is at `x`, pushes each rail down with its wheel's force of
 /// `p(wheelset)` `[left, right]` (N): the contact forces `P` (3.22 shares each between
 /// the two nodes around it), or the static loads. `loads` holds two per wheelset.
 #[inline(always)]
@@ -183,7 +223,8 @@ pub(crate) fn wheel_loads(
     }
 }
 
-/// The contact states of sample `s` of a wheelset with wheels `wheels`, whose head
+/// The contact states of sample `s` of a wheelset with wheels `wheels` moved by
+/// `vehicle`, whose head
 /// (time, rotation, wheel and rail displacements) is set, written in place: the
 /// contact law at the overlaps `z_rail - z_wheel` (2.7) with the axle at the sample's
 /// rotation, or the constant loads.

@@ -2,6 +2,9 @@
 //! roll (3.6-3.9, 3.16), rail pads and ballast, solved by explicit central
 //! differences in time and space (3.11, 3.12, 3.18).
 //!
+//! An endless track is a window of this track that moves with the wheels by whole
+//! sleeper spans ([`Track::shift_spans`]).
+//!
 //! Grid: `dx = a / n`, nodes `k = 0..=K` with `K = N n` on each rail, sleepers at
 //! every n-th node, both ends included (N spans = N + 1 sleepers). Rail ends are
 //! fixed (`Z = theta = 0`). A point force `F` enters its node's equation as `F / dx`;
@@ -23,6 +26,7 @@ mod stepper;
 mod storage;
 #[cfg(test)]
 mod tests;
+mod window;
 
 pub use crate::numerics::SimdLevel;
 pub use observe::{RailResponse, SupportResponse};

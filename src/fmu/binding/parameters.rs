@@ -114,5 +114,7 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         start_position: val(vr::START_POSITION),
         dt: val(vr::SOLVER_DT),
         sites: Vec::new(),
+        trailing: Vec::new(),
+        window: None,
     }
 }
