@@ -1,0 +1,112 @@
+//! The endless track's window against a long fixed track: the reference flat case
+//! (table 4.4, 70 km/h, 100 mm x 1.5 mm flat on the left wheel) and two wheelsets
+//! 1.8 m apart with the flat on the front one, each over `DURATION` s (default 1 s) on
+//! windows of several lengths ahead and behind, against the same run on a 600-span
+//! fixed track started in its middle (the impacts at the same places relative to the
+//! sleepers). Prints, per window: the largest force of each wheelset against the
+//! reference's, the largest difference of the whole force history over the static
+//! load, and the wall time. `cargo run --release --example window_study [AHEAD:BEHIND]...`
+use std::time::Instant;
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
+
+/// Left-wheel force history of every wheelset (N), one row per step.
+fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
+    let mut sim = Simulation::new(s).unwrap();
+    let n = (duration / sim.dt()).round() as usize;
+    let mut h = Vec::with_capacity(n);
+    let t0 = Instant::now();
+    for _ in 0..n {
+        sim.step().unwrap();
+        h.push(
+            sim.wheelsets()
+                .iter()
+                .map(|w| w.latest().contact[0].force)
+                .collect(),
+        );
+    }
+    (h, t0.elapsed().as_secs_f64())
+}
+
+fn main() {
+    let duration: f64 = std::env::var("DURATION")
+        .ok()
+        .map_or(1.0, |v| v.parse().expect("DURATION"));
+    let mut windows: Vec<(f64, f64)> = std::env::args()
+        .skip(1)
+        .map(|a| {
+            let (x, y) = a.split_once(':').expect("AHEAD:BEHIND");
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    if windows.is_empty() {
+        windows = vec![
+            (4.0, 4.0),
+            (8.0, 8.0),
+            (12.0, 12.0),
+            (16.0, 16.0),
+            (20.0, 20.0),
+            (30.0, 30.0),
+        ];
+    }
+    for bogie in [false, true] {
+        let mut base = Scenario::table_4_4_flat();
+        base.start_position = 10.0 * 0.685;
+        if bogie {
+            base.trailing.push(TrailingWheelset {
+                offset: 1.8,
+                ..Default::default()
+            });
+        }
+        let a = 0.685;
+        let mut fixed = base.clone();
+        fixed.set_spans(600);
+        fixed.start_position = base.start_position + 290.0 * a;
+        let (reference, wall) = history(&fixed, duration);
+        let load = Simulation::new(&base).unwrap().static_load()[0];
+        let peaks = |h: &[Vec<f64>]| {
+            (0..h[0].len())
+                .map(|k| h.iter().map(|r| r[k]).fold(f64::MIN, f64::max))
+                .collect::<Vec<_>>()
+        };
+        let p_ref = peaks(&reference);
+        println!(
+            "\n{}: 600-span fixed track, peaks {:?} kN, {:.2} s wall",
+            if bogie {
+                "two wheelsets 1.8 m apart, flat on the front one"
+            } else {
+                "one wheelset, the reference flat case"
+            },
+            p_ref
+                .iter()
+                .map(|p| (p / 100.0).round() / 10.0)
+                .collect::<Vec<_>>(),
+            wall
+        );
+        println!(
+            "| ahead (m) | behind (m) | spans | peak error per wheelset (%) | largest history difference / static load (%) | wall (s) |"
+        );
+        println!("|---|---|---|---|---|---|");
+        for &(ahead, behind) in &windows {
+            let mut s = base.clone();
+            s.window = Some(TrackWindow { ahead, behind });
+            let spans = Simulation::new(&s).unwrap().rail_nodes() / 2 / 8;
+            let (h, wall) = history(&s, duration);
+            let p = peaks(&h);
+            let errs: Vec<String> = p
+                .iter()
+                .zip(&p_ref)
+                .map(|(a, b)| format!("{:+.3}", 100.0 * (a - b) / b))
+                .collect();
+            let diff = h
+                .iter()
+                .zip(&reference)
+                .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+                .fold(0.0, f64::max);
+            println!(
+                "| {ahead} | {behind} | {spans} | {} | {:.3} | {wall:.2} |",
+                errs.join(", "),
+                100.0 * diff / load
+            );
+        }
+    }
+}
