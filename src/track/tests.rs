@@ -641,3 +641,61 @@ fn undamped_discrete_energy_is_conserved_over_1e5_steps() {
     }
     assert!(worst < 1e-9, "relative energy drift {worst}");
 }
+
+#[test]
+fn a_window_shift_moves_every_node_and_sleeper_back_by_whole_spans() {
+    // Node k takes node k + m n's state, sleeper i sleeper i + m's; the last m spans
+    // enter at rest and the ends are held at rest.
+    for (n, spans, m) in [(3usize, 9usize, 2usize), (8, 20, 1), (8, 20, 5)] {
+        let p = seed_track(spans, n);
+        let mut t = Track::new(p, 0.5 * p.critical_time_step().0).unwrap();
+        let nk = t.nodes();
+        let f = |k: usize, r: usize, s: f64| {
+            if k == 0 || k == nk - 1 {
+                0.0
+            } else {
+                s * (1.0 + k as f64 + 1e3 * r as f64)
+            }
+        };
+        let field = |s: f64| {
+            (0..2)
+                .flat_map(|r| (0..nk).map(move |k| f(k, r, s)))
+                .collect::<Vec<_>>()
+        };
+        t.set_state(&field(1.0), &field(2.0), &field(3.0), &field(4.0));
+        let ns = spans + 1;
+        let sl = |s: f64| (0..ns).map(|i| s * (i as f64 + 1.0)).collect::<Vec<_>>();
+        t.set_sleeper_state(&sl(5.0), &sl(6.0), &sl(7.0), &sl(8.0));
+        t.step(&[]);
+        let before = t.state_vector();
+        t.shift_spans(m).unwrap();
+        let after = t.state_vector();
+        // The state vector: dt, then z, th, z_prev, th_prev (2 nk each, node order),
+        // then zs, ph, zs_prev, ph_prev, pad left, pad right (ns each).
+        for a in 0..4 {
+            for r in 0..2 {
+                let at = |k: usize| 1 + a * 2 * nk + r * nk + k;
+                for k in 0..nk {
+                    let expected = if k == 0 || k + m * n >= nk - 1 {
+                        0.0
+                    } else {
+                        before[at(k + m * n)]
+                    };
+                    assert_eq!(after[at(k)], expected, "n {n} array {a} rail {r} node {k}");
+                }
+            }
+        }
+        for a in 0..6 {
+            let at = |i: usize| 1 + 8 * nk + a * ns + i;
+            for i in 0..ns {
+                let expected = if i + m < ns { before[at(i + m)] } else { 0.0 };
+                assert_eq!(
+                    after[at(i)],
+                    expected,
+                    "n {n} sleeper array {a} sleeper {i}"
+                );
+            }
+        }
+        assert!(t.shift_spans(spans).is_err());
+    }
+}

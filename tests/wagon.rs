@@ -1,0 +1,302 @@
+//! Several wheelsets on one track, the endless track and a varying speed, against
+//! independent references: the linear track's superposition, a 600-span fixed track,
+//! the axle's rolling without slip and the static equilibrium at standstill.
+
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use wheelflat::sim::{Scenario, Simulation, TrackState, TrackWindow, TrailingWheelset, kmh};
+
+fn trailing(offset: f64) -> TrailingWheelset {
+    TrailingWheelset {
+        offset,
+        ..Default::default()
+    }
+}
+
+fn rails(sim: &Simulation) -> Vec<f64> {
+    let TrackState::Discrete(t) = sim.track() else {
+        unreachable!()
+    };
+    let mut v = t.rail_z(0);
+    v.extend(t.rail_z(1));
+    v.extend(t.sleeper_z());
+    v
+}
+
+#[test]
+fn static_deflection_under_a_wagon_is_the_sum_of_each_wheelsets() {
+    // Four wheelsets of a wagon (axles 1.8 m apart in each bogie, bogie centres 10 m
+    // apart) on a fixed 60-span track: the track is linear, so its static deflection is
+    // the sum of each wheelset's alone (each at its place, with the same static load).
+    let offsets = [1.8, 10.0, 11.8];
+    let mut wagon = Scenario::table_4_4();
+    wagon.set_spans(60);
+    wagon.start_position = 40.0 * 0.685 + 0.3;
+    wagon.trailing = offsets.iter().map(|&d| trailing(d)).collect();
+    let all = rails(&Simulation::new(&wagon).unwrap());
+    let mut sum = vec![0.0; all.len()];
+    for d in [0.0, 1.8, 10.0, 11.8] {
+        let mut one = wagon.clone();
+        one.trailing.clear();
+        one.start_position -= d;
+        for (s, x) in sum.iter_mut().zip(rails(&Simulation::new(&one).unwrap())) {
+            *s += x;
+        }
+    }
+    let scale = all.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let err = all
+        .iter()
+        .zip(&sum)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(scale > 1e-3, "{scale}");
+    assert!(
+        err <= 1e-9 * scale,
+        "superposition error {err:e} of {scale:e}"
+    );
+}
+
+/// Left-wheel force histories (N) of every wheelset over `duration` (s).
+fn histories(s: &Scenario, duration: f64) -> Vec<Vec<f64>> {
+    let mut sim = Simulation::new(s).unwrap();
+    let n = (duration / sim.dt()).round() as usize;
+    (0..n)
+        .map(|_| {
+            sim.step().unwrap();
+            sim.wheelsets()
+                .iter()
+                .map(|w| w.latest().contact[0].force)
+                .collect()
+        })
+        .collect()
+}
+
+/// The endless track on its default window against a 600-span fixed track with the
+/// wheels started in its middle at the same place relative to the sleepers: peaks
+/// within 0.3 %, whole histories within 1 % of the static load.
+fn endless_equals_fixed(mut s: Scenario, duration: f64) {
+    s.start_position = 10.0 * 0.685;
+    let mut fixed = s.clone();
+    fixed.set_spans(600);
+    fixed.start_position += 290.0 * 0.685;
+    s.window = Some(TrackWindow::DEFAULT);
+    let load = Simulation::new(&s).unwrap().static_load()[0];
+    let (a, b) = (histories(&s, duration), histories(&fixed, duration));
+    for k in 0..a[0].len() {
+        let peak = |h: &[Vec<f64>]| h.iter().map(|r| r[k]).fold(f64::MIN, f64::max);
+        let (pa, pb) = (peak(&a), peak(&b));
+        assert!(pb > 1.5 * load, "wheelset {k}: an impact, {pb} N");
+        assert!(
+            (pa - pb).abs() <= 0.003 * pb,
+            "wheelset {k}: peak {pa} N on the window, {pb} N on the fixed track"
+        );
+        let diff = a
+            .iter()
+            .zip(&b)
+            .fold(0.0f64, |m, (x, y)| m.max((x[k] - y[k]).abs()));
+        assert!(
+            diff <= 0.01 * load,
+            "wheelset {k}: histories differ by {diff} N, static load {load} N"
+        );
+    }
+}
+
+#[test]
+fn endless_track_equals_a_long_fixed_track_for_the_reference_flat() {
+    endless_equals_fixed(Scenario::table_4_4_flat(), 0.6);
+}
+
+#[test]
+fn endless_track_equals_a_long_fixed_track_for_a_bogie_with_a_flat_in_front() {
+    let mut s = Scenario::table_4_4_flat();
+    s.trailing.push(trailing(1.8));
+    endless_equals_fixed(s, 0.6);
+}
+
+#[test]
+fn the_rear_wheelset_feels_the_front_wheelsets_impact_through_the_rails() {
+    // Two wheelsets 1.8 m apart on shared rails, the flat on the front one: the rear
+    // wheel's force swings far from its static load (issue 15: 82 to 187 kN), which
+    // separate tracks could never show.
+    let mut s = Scenario::table_4_4_flat();
+    s.trailing.push(trailing(1.8));
+    s.window = Some(TrackWindow::DEFAULT);
+    let h = histories(&s, 0.6);
+    let rear_max = h.iter().map(|r| r[1]).fold(f64::MIN, f64::max);
+    let rear_min = h.iter().map(|r| r[1]).fold(f64::MAX, f64::min);
+    let load = 107.7e3;
+    assert!(
+        rear_max > 1.5 * load && rear_min < 0.85 * load,
+        "{rear_min} {rear_max}"
+    );
+}
+
+#[test]
+fn an_endless_track_runs_past_any_fixed_length_and_positions_count_along_the_line() {
+    let mut s = Scenario::table_4_4();
+    s.window = Some(TrackWindow::DEFAULT);
+    s.trailing.push(trailing(1.8));
+    let mut sim = Simulation::new(&s).unwrap();
+    let spans = sim.rail_nodes() / 2 / 8;
+    // 3 s at 70 km/h: 58 m, far past the window's 63 spans (43 m); the last second's
+    // mean force per wheelset.
+    sim.run(2.0, |_| {}).unwrap();
+    let mut mean = [0.0; 2];
+    let n = (1.0 / sim.dt()).round() as usize;
+    for _ in 0..n {
+        sim.step().unwrap();
+        for (k, m) in mean.iter_mut().enumerate() {
+            *m += sim.wheelsets().get(k).unwrap().latest().contact[0].force / n as f64;
+        }
+    }
+    let x = sim.position();
+    let expected = s.start_position + s.speed * sim.time();
+    assert!((x - expected).abs() < 1e-9, "{x} {expected}");
+    assert!(x > spans as f64 * 0.685 + 10.0);
+    let rear = sim.sample_of(1).unwrap();
+    assert!((rear.position - (x - 1.8)).abs() < 1e-9);
+    // Perfect wheels: on average over 28 sleeper passings each wheel carries its
+    // static load.
+    for (k, m) in mean.iter().enumerate() {
+        assert!(
+            (m / sim.static_load()[0] - 1.0).abs() < 0.002,
+            "wheelset {k}: {m}"
+        );
+    }
+    assert!(sim.time_at_track_end().is_none());
+}
+
+/// Impacts of a run whose speed `speed(t)` is set every step: for each pass of the
+/// flat's centre through the contact (rotation = pi/2 mod 2 pi), the time, the speed,
+/// the time of the largest force within a quarter turn and that force.
+fn impacts(sim: &mut Simulation, speed: impl Fn(f64) -> f64, duration: f64) -> Vec<[f64; 4]> {
+    let mut out = Vec::new();
+    let mut current: Option<[f64; 4]> = None;
+    let phase = |g: f64| (g - FRAC_PI_2 + PI).rem_euclid(TAU) - PI;
+    let mut last = phase(sim.rotation());
+    for _ in 0..(duration / sim.dt()).round() as u64 {
+        sim.set_speed(speed(sim.time())).unwrap();
+        let s = sim.step().unwrap();
+        let p = phase(s.rotation);
+        if p.abs() < 0.25 * PI {
+            let c = current.get_or_insert([f64::NAN, 0.0, 0.0, 0.0]);
+            if last < 0.0 && p >= 0.0 {
+                (c[0], c[1]) = (s.time, sim.speed());
+            }
+            if s.contact[0].force > c[3] {
+                (c[2], c[3]) = (s.time, s.contact[0].force);
+            }
+        } else if let Some(c) = current.take()
+            && c[0].is_finite()
+        {
+            out.push(c);
+        }
+        last = p;
+    }
+    out
+}
+
+#[test]
+fn a_braking_run_hits_where_the_rolling_axle_puts_the_flat_and_stops() {
+    // Braking at 1 m/s^2 from 100 km/h for 4 s, then (sped up) at 10 m/s^2 to
+    // standstill: every impact peaks within 2 ms of the flat's centre reaching the
+    // contact, the rotation is the travelled distance over the radius, and at
+    // standstill the wheel rests on its static load.
+    let mut s = Scenario::table_4_4_flat();
+    s.window = Some(TrackWindow::DEFAULT);
+    let v0 = kmh(100.0);
+    s.speed = v0;
+    let mut sim = Simulation::new(&s).unwrap();
+    let speed = |t: f64| {
+        if t < 4.0 {
+            v0 - t
+        } else {
+            (v0 - 4.0 - 10.0 * (t - 4.0)).max(0.0)
+        }
+    };
+    let hits = impacts(&mut sim, speed, 7.0);
+    let turns = (sim.position() - s.start_position) / (TAU * s.wheel_radius);
+    assert!(
+        (sim.rotation() - TAU * turns).abs() < 1e-6,
+        "rotation {} for {turns} turns",
+        sim.rotation()
+    );
+    // Every turn of the flat brings an impact, as many as the turns passed.
+    let passes = ((sim.rotation() - FRAC_PI_2) / TAU).floor() as usize + 1;
+    assert!(
+        hits.len() + 1 >= passes && hits.len() <= passes,
+        "{} {passes}",
+        hits.len()
+    );
+    for h in &hits {
+        assert!(
+            (h[2] - h[0]).abs() < 2e-3,
+            "impact at {} s peaks at {} s",
+            h[0],
+            h[2]
+        );
+        assert!(h[3] > 1.3 * sim.static_load()[0], "{h:?}");
+    }
+    // Impacts weaken as the train slows: the first second's against the last's.
+    let fast = hits
+        .iter()
+        .filter(|h| h[1] > kmh(95.0))
+        .map(|h| h[3])
+        .fold(0.0, f64::max);
+    let slow = hits
+        .iter()
+        .filter(|h| h[1] < kmh(60.0))
+        .map(|h| h[3])
+        .fold(0.0, f64::max);
+    assert!(fast > 1.2 * slow && slow > 0.0, "{fast} {slow}");
+    assert_eq!(sim.speed(), 0.0);
+    let x = sim.position();
+    sim.run(0.5, |_| {}).unwrap();
+    assert_eq!(sim.position(), x);
+    let f = sim.sample().contact[0].force;
+    assert!((f / sim.static_load()[0] - 1.0).abs() < 0.01, "{f}");
+}
+
+#[test]
+fn a_constant_speed_set_every_step_changes_no_bit() {
+    let s = Scenario::table_4_4_flat();
+    let mut a = Simulation::new(&s).unwrap();
+    let mut b = Simulation::new(&s).unwrap();
+    for _ in 0..3000 {
+        b.set_speed(s.speed).unwrap();
+        assert_eq!(a.step().unwrap(), b.step().unwrap());
+    }
+}
+
+#[test]
+fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
+    let name = |s: &Scenario| match Simulation::new(s) {
+        Err(wheelflat::Error::Parameter { name, .. }) => name,
+        other => panic!("{other:?}"),
+    };
+    let mut s = Scenario::table_4_4();
+    s.trailing = vec![trailing(1.8), trailing(1.0)];
+    assert_eq!(name(&s), "wheelset[3].offset");
+    s.trailing = vec![trailing(-1.0)];
+    assert_eq!(name(&s), "wheelset[2].offset");
+    s.trailing = (1..5).map(|k| trailing(k as f64)).collect();
+    assert_eq!(name(&s), "wheelsets");
+    s.trailing = vec![trailing(30.0)];
+    assert_eq!(name(&s), "start_position");
+    s.trailing.clear();
+    s.window = Some(TrackWindow {
+        ahead: 0.1,
+        behind: 20.0,
+    });
+    assert_eq!(name(&s), "track.window.ahead");
+    s.window = Some(TrackWindow {
+        ahead: 20.0,
+        behind: f64::NAN,
+    });
+    assert_eq!(name(&s), "track.window.behind");
+    let mut sim = Simulation::new(&Scenario::table_4_4()).unwrap();
+    for v in [-1.0, f64::NAN, 1e3] {
+        match sim.set_speed(v) {
+            Err(wheelflat::Error::Parameter { name, .. }) => assert_eq!(name, "speed"),
+            other => panic!("{v}: {other:?}"),
+        }
+    }
+}
