@@ -301,8 +301,8 @@ def test_calls_out_of_order_are_refused_and_logged(paths):
     u.fmu.enterInitializationMode()
     u.fmu.exitInitializationMode()
     with pytest.raises(FMICallException):
-        u.set(["speed"], [10.0])
-    assert "`speed`" in log.last()[2] and "cannot be set" in log.last()[2]
+        u.set(["wheel.radius"], [0.5])
+    assert "`wheel.radius`" in log.last()[2] and "cannot be set" in log.last()[2]
     u.fmu.doStep(0.0, 1e-5)
     u.close()
 
@@ -665,3 +665,41 @@ def test_static_handshake_puts_the_pair_at_rest(paths):
     # moving load on discrete sleepers: small parametric ripple only
     assert np.max(np.abs(f - f[0])) < 0.02 * f[0]
     assert math.isfinite(f[-1])
+
+
+# ------------------------------------------------------------------ endless track, speed input
+
+def test_an_endless_track_runs_past_the_fixed_tracks_end_and_matches_the_engine(paths):
+    # The default fixed track ends at 0.986 s; with track.window.ahead = 20 m the run
+    # goes on to its stop time, and its peak equals the engine's endless run (the
+    # Rust test `endless_track_equals_a_long_fixed_track_*` compares the engine with a
+    # 600-span fixed track).
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=2.0, output_interval=1e-3,
+                     start_values={"track.window.ahead": 20.0},
+                     output=["position", "contact.left.max_force", "contact.left.force"])
+    assert r["time"][-1] == pytest.approx(2.0)
+    # The model ends each step on its grid point nearest the master's time: within
+    # half a step (7.2 us, 0.14 mm at 70 km/h).
+    assert r["position"][-1] == pytest.approx(1.37 + 70 / 3.6 * 2.0, abs=1.5e-4)
+    peak = r["contact.left.max_force"][-1]
+    # The reference flat's impacts on the converged grid peak at 306 to 380 kN.
+    assert 2.8e5 < peak < 4.0e5
+
+
+def test_a_speed_input_brakes_the_coupled_system_to_standstill(paths):
+    # Speed as an input: from 100 km/h at 10 m/s^2 to standstill in 2.78 s, then 0.5 s
+    # at rest. The position is the integral of the speed (held over each 1 ms step),
+    # and at rest the wheel carries its static load.
+    v0, a, dt = 100 / 3.6, 10.0, 1e-3
+    t = np.arange(0.0, 3.3 + dt / 2, dt)
+    v = np.maximum(v0 - a * t, 0.0)
+    signal = np.array(list(zip(t, v)), dtype=[("time", np.float64), ("speed", np.float64)])
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=3.3, step_size=dt, output_interval=dt,
+                     start_values={"track.window.ahead": 20.0, "speed": v0}, input=signal,
+                     output=["position", "contact.left.force", "static_load.left"])
+    travelled = r["position"][-1] - 1.37
+    held = np.sum(v[:-1]) * dt  # zero-order hold over each communication step
+    assert travelled == pytest.approx(held, abs=0.05)
+    assert travelled == pytest.approx(v0 ** 2 / (2 * a), rel=0.01)
+    assert r["position"][-1] == r["position"][-200]
+    assert r["contact.left.force"][-1] == pytest.approx(r["static_load.left"][-1], rel=0.01)

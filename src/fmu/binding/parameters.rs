@@ -5,7 +5,7 @@ use super::Kind;
 use crate::contact::ContactModel;
 use crate::fmu::vars::{FLAT_VRS, enums, vr};
 use crate::sim::VehicleUnitParams;
-use crate::sim::{Scenario, TrackSpec, VehicleSpec};
+use crate::sim::{Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
 use crate::wheel::{FlatShape, FlatSpec};
@@ -115,6 +115,9 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         dt: val(vr::SOLVER_DT),
         sites: Vec::new(),
         trailing: Vec::new(),
-        window: None,
+        window: (val(vr::TRACK_WINDOW_AHEAD) > 0.0).then(|| TrackWindow {
+            ahead: val(vr::TRACK_WINDOW_AHEAD),
+            behind: val(vr::TRACK_WINDOW_BEHIND),
+        }),
     }
 }

@@ -125,9 +125,17 @@ impl Model for FmuModel {
     fn set_inputs(&mut self, values: &[f64], changed: &[u32]) -> Result<(), Error> {
         let v = |r: u32| values[r as usize];
         match (&mut self.engine, self.kind) {
-            (Engine::Sim(sim), Kind::TrackContact) => {
+            (Engine::Sim(sim), kind) => {
+                if changed.contains(&vr::SPEED) {
+                    sim.set_speed(v(vr::SPEED))?;
+                }
+                if kind != Kind::TrackContact {
+                    return Ok(());
+                }
                 let rotation = changed.contains(&vr::WHEEL_ROTATION);
-                let heights = changed.iter().any(|&r| r != vr::WHEEL_ROTATION);
+                let heights = changed
+                    .iter()
+                    .any(|&r| r == vr::WHEEL_LEFT_Z || r == vr::WHEEL_RIGHT_Z);
                 if heights {
                     sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
                 }
@@ -139,7 +147,6 @@ impl Model for FmuModel {
             (Engine::Vehicle(u), _) => {
                 u.set_forces([v(vr::CONTACT_LEFT_FORCE), v(vr::CONTACT_RIGHT_FORCE)])
             }
-            _ => Ok(()),
         }
     }
 
@@ -230,6 +237,9 @@ impl Model for FmuModel {
         let TrackSpec::Discrete(p) = &sim.scenario().track else {
             return None;
         };
+        if sim.window().is_some() {
+            return None;
+        }
         let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
         let x = sim.position();
         (x > zone).then(|| {
