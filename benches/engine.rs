@@ -6,7 +6,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
-use wheelflat::sim::{Scenario, Simulation};
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
 use wheelflat::wheel::{FlatSpec, WheelProfile};
 
 /// Simulated time per benchmark iteration of the scaling and FMU groups (s).
@@ -166,5 +166,59 @@ fn fmu_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, reference, scaling, contact, fmu_step);
+/// A four-axle wagon's wheelsets behind the leading one (m): two bogies with 1.8 m
+/// wheelbases, their centres 10 m apart.
+const WAGON: [f64; 3] = [1.8, 10.0, 11.8];
+
+/// The reference flat case on the endless track with `wheelsets` wheelsets of the
+/// wagon and window sides `side` (m).
+fn endless(wheelsets: usize, side: f64) -> Simulation {
+    let mut s = Scenario::table_4_4_flat();
+    s.window = Some(TrackWindow {
+        ahead: side,
+        behind: side,
+    });
+    s.trailing = WAGON[..wheelsets - 1]
+        .iter()
+        .map(|&offset| TrailingWheelset {
+            offset,
+            ..Default::default()
+        })
+        .collect();
+    Simulation::new(&s).unwrap()
+}
+
+/// Cost per simulated second (one iteration = 1 s) on the endless track: the default
+/// window with 1 to 4 wheelsets, and one wheelset on windows of 8 to 30 m a side.
+fn endless_track(c: &mut Criterion) {
+    let mut g = c.benchmark_group("endless_track_per_1s");
+    g.sample_size(10);
+    let side = TrackWindow::DEFAULT.ahead;
+    for w in 1..=4 {
+        let sim = endless(w, side);
+        g.bench_with_input(
+            BenchmarkId::new("wheelsets_default_window", w),
+            &sim,
+            |b, sim| b.iter(|| run_for(sim, 1.0)),
+        );
+    }
+    for side in [8.0, 12.0, 30.0] {
+        let sim = endless(1, side);
+        g.bench_with_input(
+            BenchmarkId::new("one_wheelset_window_side_m", side),
+            &sim,
+            |b, sim| b.iter(|| run_for(sim, 1.0)),
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    reference,
+    scaling,
+    contact,
+    fmu_step,
+    endless_track
+);
 criterion_main!(benches);

@@ -1,0 +1,51 @@
+//! A four-axle wagon (wheelsets 0, 1.8, 10 and 11.8 m behind the leading one, the
+//! reference flat on the leading wheelset's left wheel) on the endless track at the
+//! converged grid and the default window, 60 s at 70 km/h: the peak resident memory
+//! (VmHWM) and the wall time at 1, 10 and 60 s of simulated time. Memory stays constant
+//! because the window moves with the wagon. Linux only (reads /proc/self/status).
+//! `cargo run --release --example wagon_memory`
+use std::time::Instant;
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
+
+fn peak_rss_kib() -> u64 {
+    let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    s.lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(0)
+}
+
+fn main() {
+    let mut s = Scenario::table_4_4_flat();
+    s.window = Some(TrackWindow::DEFAULT);
+    s.trailing = [1.8, 10.0, 11.8]
+        .iter()
+        .map(|&offset| TrailingWheelset {
+            offset,
+            ..Default::default()
+        })
+        .collect();
+    let before = peak_rss_kib();
+    let mut sim = Simulation::new(&s).unwrap();
+    println!(
+        "four wheelsets, window of {} spans; peak RSS before building: {before} KiB",
+        sim.rail_nodes() / 2 / 8
+    );
+    println!("| simulated (s) | position (m) | peak RSS (KiB) | wall (s) | largest force, leading / rear wheelset of the front bogie (kN) |");
+    println!("|---|---|---|---|---|");
+    let t0 = Instant::now();
+    let mut done = 0.0;
+    for mark in [1.0, 10.0, 60.0] {
+        sim.run(mark - done, |_| {}).unwrap();
+        done = mark;
+        let w = sim.wheelsets();
+        println!(
+            "| {mark} | {:.1} | {} | {:.2} | {:.1} / {:.1} |",
+            sim.position(),
+            peak_rss_kib(),
+            t0.elapsed().as_secs_f64(),
+            w.get(0).unwrap().max_force()[0] / 1e3,
+            w.get(1).unwrap().max_force()[0] / 1e3
+        );
+    }
+}
