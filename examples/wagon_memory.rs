@@ -31,7 +31,9 @@ fn main() {
         "four wheelsets, window of {} spans; peak RSS before building: {before} KiB",
         sim.rail_nodes() / 2 / 8
     );
-    println!("| simulated (s) | position (m) | peak RSS (KiB) | wall (s) | largest force, leading / rear wheelset of the front bogie (kN) |");
+    println!(
+        "| simulated (s) | position (m) | peak RSS (KiB) | wall (s) | largest force, leading / rear wheelset of the front bogie (kN) |"
+    );
     println!("|---|---|---|---|---|");
     let t0 = Instant::now();
     let mut done = 0.0;

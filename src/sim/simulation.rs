@@ -781,19 +781,17 @@ impl Simulation {
             (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
             contact_states(vehicle, &self.law, wheels, s);
         }
-        if !self.wheelsets.trailing().is_empty() {
-            self.sample_trailing();
+        let s = &self.lead().latest;
+        let (zw, zr) = (s.wheel_z, s.rail_z);
+        if !(within(zw[0], DISPLACEMENT_LIMIT)
+            && within(zw[1], DISPLACEMENT_LIMIT)
+            && within(zr[0], DISPLACEMENT_LIMIT)
+            && within(zr[1], DISPLACEMENT_LIMIT))
+        {
+            return Err(self.displacement_diverged(self.lead()));
         }
-        for w in self.wheelsets.iter() {
-            let s = &w.latest;
-            let (zw, zr) = (s.wheel_z, s.rail_z);
-            if !(within(zw[0], DISPLACEMENT_LIMIT)
-                && within(zw[1], DISPLACEMENT_LIMIT)
-                && within(zr[0], DISPLACEMENT_LIMIT)
-                && within(zr[1], DISPLACEMENT_LIMIT))
-            {
-                return Err(self.displacement_diverged(w));
-            }
+        if !self.wheelsets.trailing().is_empty() {
+            self.sample_trailing()?;
         }
         let time = self.lead().latest.time;
         self.advance_with(x, time)?;
@@ -803,17 +801,46 @@ impl Simulation {
         Ok(self.lead().latest)
     }
 
-    /// The samples at `t_j` of the wheelsets behind the leading one, in place.
+    /// The samples at `t_j` of the wheelsets behind the leading one, in place, with
+    /// their displacements checked as the leading one's.
     #[inline(never)]
-    fn sample_trailing(&mut self) {
+    fn sample_trailing(&mut self) -> Result<()> {
         for k in 0..self.wheelsets.trailing().len() {
             let w = &self.wheelsets.trailing()[k];
-            let sample = match w.cached.take() {
+            let s = match w.cached.take() {
                 Some(s) => s,
                 None => self.compute_sample(w),
             };
-            self.wheelsets.trailing_mut()[k].latest = sample;
+            let (zw, zr) = (s.wheel_z, s.rail_z);
+            self.wheelsets.trailing_mut()[k].latest = s;
+            if !(within(zw[0], DISPLACEMENT_LIMIT)
+                && within(zw[1], DISPLACEMENT_LIMIT)
+                && within(zr[0], DISPLACEMENT_LIMIT)
+                && within(zr[1], DISPLACEMENT_LIMIT))
+            {
+                return Err(self.displacement_diverged(&self.wheelsets.trailing()[k]));
+            }
         }
+        Ok(())
+    }
+
+    /// The wheelsets behind the leading one: their contact forces checked against the
+    /// force limit, then their extremes and vehicles advanced.
+    #[inline(never)]
+    fn advance_trailing(&mut self, time: f64) -> Result<()> {
+        let lim = self.force_limit;
+        for w in self.wheelsets.trailing() {
+            let p = w.forces();
+            if !(within(p[0], lim) && within(p[1], lim)) {
+                return Err(self.force_diverged(p, time));
+            }
+        }
+        for w in self.wheelsets.trailing_mut() {
+            let p = w.forces();
+            w.extremes.record(p);
+            w.vehicle.step(p);
+        }
+        Ok(())
     }
 
     /// Advances `n` steps of [`Simulation::dt`]. A run whose end would carry the
@@ -891,18 +918,17 @@ impl Simulation {
     /// passed its mark.
     #[inline(always)]
     fn advance_with(&mut self, x: f64, time: f64) -> Result<()> {
+        let p = self.lead().forces();
         let lim = self.force_limit;
-        for w in self.wheelsets.iter() {
-            let p = w.forces();
-            if !(within(p[0], lim) && within(p[1], lim)) {
-                return Err(self.force_diverged(p, time));
-            }
+        if !(within(p[0], lim) && within(p[1], lim)) {
+            return Err(self.force_diverged(p, time));
         }
-        for w in self.wheelsets.iter_mut() {
-            let p = w.forces();
-            w.extremes.record(p);
-            w.vehicle.step(p);
+        if !self.wheelsets.trailing().is_empty() {
+            self.advance_trailing(time)?;
         }
+        let lead = self.wheelsets.lead_mut();
+        lead.extremes.record(p);
+        lead.vehicle.step(p);
         match &mut self.track {
             TrackState::Discrete(t) => {
                 wheel_loads(
