@@ -55,6 +55,7 @@ pub fn write(table: &Table, guids: &[String]) -> String {
     writeln!(rust, "}}\n").unwrap();
     enumerations(&mut rust, table);
     flat_vrs(&mut rust, table);
+    wheelset_vrs(&mut rust, table);
     quantities(&mut rust, table);
     for (fmu, g) in table.fmus.iter().zip(guids) {
         let id = fmu.id();
@@ -144,6 +145,90 @@ fn flat_vrs(rust: &mut String, table: &Table) {
     writeln!(rust, "];\n").unwrap();
 }
 
+/// The value reference of `name`; panics naming it when the table lacks it.
+fn vr_of(table: &Table, name: &str) -> u32 {
+    *table
+        .names
+        .get(name)
+        .unwrap_or_else(|| panic!("{name} missing from the table")) as u32
+}
+
+/// The value references of the wheelsets behind the leading one (`wheelset[k].*`, `k`
+/// from 2) and of the observation points (`site[j].position`).
+fn wheelset_vrs(rust: &mut String, table: &Table) {
+    let trailing: Vec<usize> = (2..)
+        .take_while(|k| table.names.contains_key(&format!("wheelset[{k}].offset")))
+        .collect();
+    let per_wheel = (1..)
+        .take_while(|i| table.names.contains_key(&format!("flat.left[{i}].length")))
+        .count();
+    let n = trailing.len();
+    let list = |f: &dyn Fn(usize) -> String| -> String {
+        trailing
+            .iter()
+            .map(|&k| f(k))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    writeln!(
+        rust,
+        "/// Wheelsets behind the leading one in the table (`wheelset[2]` onwards).
+         pub const TRAILING: usize = {n};
+         /// `wheelset[k].offset`, k = 2, 3, ..
+         pub const OFFSET_VRS: [u32; {n}] = [{}];
+         /// `wheelset[k].wheel.left.z`, `.right.z`, `.rotation`, k = 2, 3, ..
+         pub const TRAILING_INPUT_VRS: [[u32; 3]; {n}] = [{}];",
+        list(&|k| vr_of(table, &format!("wheelset[{k}].offset")).to_string()),
+        list(&|k| format!(
+            "[{}, {}, {}]",
+            vr_of(table, &format!("wheelset[{k}].wheel.left.z")),
+            vr_of(table, &format!("wheelset[{k}].wheel.right.z")),
+            vr_of(table, &format!("wheelset[{k}].wheel.rotation"))
+        )),
+    )
+    .unwrap();
+    writeln!(
+        rust,
+        "/// The flats of wheelset k = 2, 3, .. `[k - 2][side][i]`: length, depth, angle, shape.
+         pub const TRAILING_FLAT_VRS: [[[[u32; 4]; {per_wheel}]; 2]; {n}] = [{}];",
+        list(&|k| {
+            let sides: Vec<String> = ["left", "right"]
+                .iter()
+                .map(|side| {
+                    let flats: Vec<String> = (1..=per_wheel)
+                        .map(|i| {
+                            let f: Vec<String> = ["length", "depth", "angle", "shape"]
+                                .iter()
+                                .map(|q| {
+                                    vr_of(table, &format!("wheelset[{k}].flat.{side}[{i}].{q}"))
+                                        .to_string()
+                                })
+                                .collect();
+                            format!("[{}]", f.join(", "))
+                        })
+                        .collect();
+                    format!("[{}]", flats.join(", "))
+                })
+                .collect();
+            format!("[{}]", sides.join(", "))
+        })
+    )
+    .unwrap();
+    let sites: Vec<String> = (1..)
+        .map_while(|j| table.names.get(&format!("site[{j}].position")))
+        .map(|r| r.to_string())
+        .collect();
+    writeln!(
+        rust,
+        "/// `site[j].position`, j = 1, 2, ..
+         pub const SITE_POSITION_VRS: [u32; {}] = [{}];
+",
+        sites.len(),
+        sites.join(", ")
+    )
+    .unwrap();
+}
+
 /// One `VarSpec` of FMU `id`.
 fn var_spec(rust: &mut String, table: &Table, id: &str, v: &FmuVar) {
     let num = |k: &str, dflt: &str| -> String {
@@ -199,6 +284,9 @@ fn quantity_of(name: &str) -> (String, usize) {
         match seg {
             "left" => side = 0,
             "right" => side = 1,
+            // Every wheelset has the leading one's quantities.
+            s if s.starts_with("wheelset[") => {}
+            s if s.starts_with("site[") => q.push_str("Site"),
             _ => {
                 for word in seg.split('_') {
                     let mut c = word.chars();
@@ -211,6 +299,20 @@ fn quantity_of(name: &str) -> (String, usize) {
         }
     }
     (q, side)
+}
+
+/// The index of `wheelset[k].*` or `site[k].*`: `k - 1`; 0 for other names.
+fn index_of(name: &str) -> usize {
+    let first = name.split('.').next().unwrap_or("");
+    match first.split_once('[') {
+        Some(("wheelset" | "site", rest)) => {
+            rest.trim_end_matches(']')
+                .parse::<usize>()
+                .expect("an index")
+                - 1
+        }
+        _ => 0,
+    }
 }
 
 /// The quantities of the outputs and calculated parameters (of any FMU), and each such
@@ -238,10 +340,15 @@ fn quantities(rust: &mut String, table: &Table) {
                 .split('.')
                 .map(|s| if s == "left" || s == "right" { "*" } else { s })
                 .collect::<Vec<_>>()
-                .join(".");
+                .join(".")
+                .replace(|c: char| c.is_ascii_digit(), "k")
+                .replace("flat.*[k]", "flat.*[i]");
             kinds.push((q.clone(), generic));
         }
-        per_vr.push(format!("Some((Quantity::{q}, {side}))"));
+        per_vr.push(format!(
+            "Some((Quantity::{q}, {side}, {}))",
+            index_of(v.name())
+        ));
     }
     writeln!(
         rust,
@@ -255,9 +362,10 @@ fn quantities(rust: &mut String, table: &Table) {
     }
     writeln!(
         rust,
-        "}}\n\n/// The quantity and side (0 left, 1 right, 0 for quantities without a side) of\n\
+        "}}\n\n/// The quantity, side (0 left, 1 right, 0 for quantities without a side) and\n\
+         /// index (0 for the leading wheelset, k - 1 for `wheelset[k]` and `site[k]`) of\n\
          /// each value reference that is an output or calculated parameter of an FMU.\n\
-         pub static QUANTITIES: [Option<(Quantity, usize)>; N_VR] = ["
+         pub static QUANTITIES: [Option<(Quantity, usize, usize)>; N_VR] = ["
     )
     .unwrap();
     for q in per_vr {

@@ -128,19 +128,35 @@ impl Table {
                     sections.insert(name, text[start..end].to_string());
                 }
                 Event::Empty(e) if e.name().as_ref() == "Fmu" => fmus.push(attrs(&e)),
+                Event::Start(e) if e.name().as_ref() == "Repeat" => {
+                    // The body once per position of the attributes' lists, `{name}`
+                    // replaced by the list's item there.
+                    let lists: Vec<(String, Vec<String>)> = attrs(&e)
+                        .into_iter()
+                        .map(|(k, v)| (k, v.split_whitespace().map(String::from).collect()))
+                        .collect();
+                    let body_start = reader.buffer_position() as usize;
+                    reader.read_to_end(e.name()).expect("closed Repeat");
+                    let end = reader.buffer_position() as usize;
+                    let body = &text[body_start..text[..end].rfind("</Repeat>").unwrap()];
+                    let n = lists.first().map_or(0, |(_, l)| l.len());
+                    assert!(
+                        lists.iter().all(|(_, l)| l.len() == n),
+                        "Repeat: every list must have {n} items"
+                    );
+                    for i in 0..n {
+                        let mut b = body.to_string();
+                        for (k, l) in &lists {
+                            b = b.replace(&format!("{{{k}}}"), &l[i]);
+                        }
+                        read_variables(&mut Reader::from_str(&b), &mut vars);
+                    }
+                }
                 Event::Start(e) | Event::Empty(e) if e.name().as_ref() == "Variable" => {
-                    vars.push(TableVar {
-                        attrs: attrs(&e),
-                        overrides: BTreeMap::new(),
-                    });
+                    variable_event(&e, &mut vars);
                 }
                 Event::Empty(e) if e.name().as_ref() == "Override" => {
-                    let mut a = attrs(&e);
-                    let fmu = a.remove("fmu").expect("Override needs fmu=");
-                    vars.last_mut()
-                        .expect("Override inside a Variable")
-                        .overrides
-                        .insert(fmu, a);
+                    variable_event(&e, &mut vars);
                 }
                 _ => {}
             }
@@ -184,6 +200,38 @@ impl Table {
             "{ty}: item values must be consecutive"
         );
         (lo, hi)
+    }
+}
+
+/// A `<Variable>` (a new variable) or `<Override>` (of the last one) element.
+fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>) {
+    if e.name().as_ref() == "Variable" {
+        vars.push(TableVar {
+            attrs: attrs(e),
+            overrides: BTreeMap::new(),
+        });
+    } else {
+        let mut a = attrs(e);
+        let fmu = a.remove("fmu").expect("Override needs fmu=");
+        vars.last_mut()
+            .expect("Override inside a Variable")
+            .overrides
+            .insert(fmu, a);
+    }
+}
+
+/// The variables of a `<Repeat>` body, in order.
+fn read_variables(reader: &mut Reader<&[u8]>, vars: &mut Vec<TableVar>) {
+    loop {
+        match reader.read_event().expect("well-formed Repeat body") {
+            Event::Eof => break,
+            Event::Start(e) | Event::Empty(e)
+                if matches!(e.name().as_ref(), "Variable" | "Override") =>
+            {
+                variable_event(&e, vars);
+            }
+            _ => {}
+        }
     }
 }
 

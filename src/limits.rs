@@ -48,7 +48,7 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("contact.CH", 0.0, 1e13, "N/m^1.5"),
     r("track.sleeper_spacing", 0.1, 3.0, "m"),
     r("track.window.ahead", 0.0, 1000.0, "m"),
-    r("track.window.behind", 0.1, 1000.0, "m"),
+    r("track.window.behind", 4.0, 1000.0, "m"),
     r("track.rail_seat_distance", 0.3, 3.0, "m"),
     r("track.rail.EI", 3e5, 1e9, "N m^2"),
     r("track.rail.kAG", 1e7, 1e11, "N"),

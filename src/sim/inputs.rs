@@ -39,9 +39,13 @@ impl Simulation {
         let n = self.wheelsets.len();
         let w = self.wheelsets.get_mut(k).ok_or_else(|| {
             out_of_range(
-                "wheelset",
-                k as f64 + 1.0,
-                format!("1 to {n}, the wheelsets of this simulation"),
+                "wheelset index",
+                k as f64,
+                format!(
+                    "0 (the leading wheelset) to {} (wheelset[{n}]), the wheelsets of this \
+                     simulation",
+                    n - 1
+                ),
             )
         })?;
         match &mut w.vehicle {

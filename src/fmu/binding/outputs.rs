@@ -3,7 +3,7 @@
 use super::FmuModel;
 use super::unit::Engine;
 use crate::contact::ContactState;
-use crate::fmu::vars::{QUANTITIES, Quantity};
+use crate::fmu::vars::{QUANTITIES, Quantity, TRAILING};
 use crate::sim::VehicleUnit;
 use crate::sim::{Sample, Simulation, VehicleState};
 use crate::track::RailResponse;
@@ -15,6 +15,9 @@ pub(super) struct Published {
     pub static_load: [f64; 2],
     /// `static_wheel_z.left`/`.right` (m).
     pub static_wheel_z: [f64; 2],
+    /// `wheelset[k].static_wheel_z.left`/`.right` (m), k = 2, 3, .. (0 for a wheelset
+    /// the model does not have).
+    pub trailing_static_wheel_z: [[f64; 2]; TRAILING],
     /// `solver.step` (s).
     pub step: f64,
     /// `solver.critical_step` (s).
@@ -24,11 +27,22 @@ pub(super) struct Published {
 }
 
 impl Published {
+    /// Number of values in [`Published::to_array`].
+    pub const LEN: usize = 7 + 2 * TRAILING;
+
     /// The values in the order FMU states store them.
-    pub fn to_array(self) -> [f64; 7] {
+    pub fn to_array(self) -> [f64; Self::LEN] {
         let [l, r] = self.static_load;
         let [zl, zr] = self.static_wheel_z;
-        [l, r, zl, zr, self.step, self.critical_step, self.kw_used]
+        let mut a = [0.0; Self::LEN];
+        a[..7].copy_from_slice(&[l, r, zl, zr, self.step, self.critical_step, self.kw_used]);
+        for (pair, z) in a[7..]
+            .chunks_exact_mut(2)
+            .zip(&self.trailing_static_wheel_z)
+        {
+            pair.copy_from_slice(z);
+        }
+        a
     }
 }
 
@@ -47,13 +61,26 @@ impl FmuModel {
     /// The table names each computed variable's quantity and side
     /// ([`QUANTITIES`]); this is the one place a quantity meets the engine.
     pub(super) fn output_value(&self, r: u32, sample: Option<&Sample>) -> f64 {
-        let Some(&Some((q, side))) = QUANTITIES.get(r as usize) else {
+        let Some(&Some((q, side, index))) = QUANTITIES.get(r as usize) else {
             return f64::NAN;
         };
         let p = &self.published;
+        if let Some(x) = site_value(&self.engine, q, side, index) {
+            return x;
+        }
+        // Wheelset `index` (0 the leading one) of a track-carrying model; a wheelset
+        // the model does not have reads 0.
+        let trailing;
         let view = match (&self.engine, sample) {
             (Engine::Vehicle(u), _) => View::Vehicle(u),
-            (Engine::Sim(sim), Some(s)) => View::Sim(sim, s),
+            (Engine::Sim(sim), Some(s)) if index == 0 => View::Sim(sim, s),
+            (Engine::Sim(sim), Some(_)) => match sim.sample_of(index) {
+                Some(s) => {
+                    trailing = s;
+                    View::Sim(sim, &trailing)
+                }
+                None => return 0.0,
+            },
             (Engine::Sim(_), None) => return f64::NAN,
         };
         // The contact state of a track-carrying model (the vehicle has none).
@@ -63,29 +90,37 @@ impl FmuModel {
         };
         // The rail under this side's wheel of a track-carrying model.
         let rail = |f: fn(&RailResponse) -> f64| match view {
-            View::Sim(sim, _) => sim.rail_under_wheel(side).map_or(f64::NAN, |r| f(&r)),
+            View::Sim(sim, _) => sim
+                .rail_under_wheel_of(index, side)
+                .map_or(f64::NAN, |r| f(&r)),
             View::Vehicle(_) => f64::NAN,
         };
         // The roll-plane vehicle's displacements and bearing forces, where there is one.
         let body = |k: usize| match view {
             View::Vehicle(u) => u.displacements()[k],
-            View::Sim(sim, _) => match sim.vehicle() {
-                VehicleState::RollPlane(v) => v.displacements()[k],
+            View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                Some(VehicleState::RollPlane(v)) => v.displacements()[k],
                 _ => f64::NAN,
             },
         };
         let bearing = || match view {
             View::Vehicle(u) => u.bearing_forces()[side],
-            View::Sim(sim, _) => match sim.vehicle() {
-                VehicleState::RollPlane(v) => v.bearing_forces()[side],
+            View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                Some(VehicleState::RollPlane(v)) => v.bearing_forces()[side],
                 _ => f64::NAN,
             },
+        };
+        let extremes = |sim: &Simulation| {
+            sim.wheelsets()
+                .get(index)
+                .map_or(([0.0; 2], [0.0; 2]), |w| (w.max_force(), w.min_force()))
         };
         match q {
             Quantity::SolverStep => p.step,
             Quantity::SolverCriticalStep => p.critical_step,
             Quantity::StaticLoad => p.static_load[side],
-            Quantity::StaticWheelZ => p.static_wheel_z[side],
+            Quantity::StaticWheelZ if index == 0 => p.static_wheel_z[side],
+            Quantity::StaticWheelZ => p.trailing_static_wheel_z[index - 1][side],
             Quantity::ContactKwUsed => p.kw_used,
             Quantity::WheelZ => match view {
                 View::Vehicle(u) => u.wheel_z()[side],
@@ -104,11 +139,11 @@ impl FmuModel {
             // The extremes up to the last step, with the force at the current time.
             Quantity::ContactMaxForce => match view {
                 View::Vehicle(u) => u.max_force()[side],
-                View::Sim(sim, s) => sim.max_force()[side].max(s.contact[side].force),
+                View::Sim(sim, s) => extremes(sim).0[side].max(s.contact[side].force),
             },
             Quantity::ContactMinForce => match view {
                 View::Vehicle(u) => u.min_force()[side],
-                View::Sim(sim, s) => sim.min_force()[side].min(s.contact[side].force),
+                View::Sim(sim, s) => extremes(sim).1[side].min(s.contact[side].force),
             },
             Quantity::RailZ => match view {
                 View::Sim(_, s) => s.rail_z[side],
@@ -127,6 +162,48 @@ impl FmuModel {
             Quantity::WheelsetZ => body(4),
             Quantity::WheelsetRoll => body(5),
             Quantity::PrimaryForce => bearing(),
+            // Observation points: `site_value` above.
+            _ => f64::NAN,
         }
     }
+}
+
+/// The value of an observation point's quantity `q` on `side` at site `index`: what
+/// the track feels there now, or its extremes; 0 for a site the model does not have.
+/// `None` for the other quantities.
+fn site_value(engine: &Engine, q: Quantity, side: usize, index: usize) -> Option<f64> {
+    use Quantity::*;
+    // [`crate::sim::SITE_QUANTITIES`] order, then now (0), max (1) or min (2).
+    let (k, which) = match q {
+        SiteRailZ => (0, 0),
+        SiteRailZMax => (0, 1),
+        SiteRailZMin => (0, 2),
+        SiteRailBendingMoment => (1, 0),
+        SiteRailBendingMomentMax => (1, 1),
+        SiteRailBendingMomentMin => (1, 2),
+        SiteRailShearForce => (2, 0),
+        SiteRailShearForceMax => (2, 1),
+        SiteRailShearForceMin => (2, 2),
+        SiteSeatForce => (3, 0),
+        SiteSeatForceMax => (3, 1),
+        SiteSeatForceMin => (3, 2),
+        SiteSeatZ => (4, 0),
+        SiteSeatZMax => (4, 1),
+        SiteSeatZMin => (4, 2),
+        SiteBallastForce => (5, 0),
+        SiteBallastForceMax => (5, 1),
+        SiteBallastForceMin => (5, 2),
+        _ => return None,
+    };
+    let Engine::Sim(sim) = engine else {
+        return Some(f64::NAN);
+    };
+    Some(sim.sites().get(index).map_or(0.0, |site| {
+        let values = match which {
+            0 => site.now(),
+            1 => site.max(),
+            _ => site.min(),
+        };
+        values[side][k]
+    }))
 }

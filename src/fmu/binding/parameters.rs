@@ -3,9 +3,11 @@
 
 use super::Kind;
 use crate::contact::ContactModel;
-use crate::fmu::vars::{FLAT_VRS, enums, vr};
+use crate::fmu::vars::{
+    FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
+};
 use crate::sim::VehicleUnitParams;
-use crate::sim::{Scenario, TrackSpec, TrackWindow, VehicleSpec};
+use crate::sim::{Scenario, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::RollPlaneParams;
 use crate::wheel::{FlatShape, FlatSpec};
@@ -68,28 +70,42 @@ pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
     }
 }
 
+/// The flat whose variables (length, depth, angle, shape) have the value references
+/// `f`; a length of 0 is no flat.
+fn flat(v: &[f64], f: &[u32; 4]) -> FlatSpec {
+    let val = |r: u32| v[r as usize];
+    let depth = val(f[1]);
+    FlatSpec {
+        length: val(f[0]),
+        depth: if depth == 0.0 { None } else { Some(depth) },
+        angle: val(f[2]),
+        shape: if val(f[3]) == enums::flat_shape::CHORD {
+            FlatShape::Chord
+        } else {
+            FlatShape::Haversine
+        },
+    }
+}
+
 /// The scenario the variables of a track-carrying FMU describe: CoupledSystem carries
 /// the roll-plane vehicle, TrackContact external wheels with the given static loads.
 pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
     let val = |r: u32| v[r as usize];
-    let flats = [0, 1].map(|side| {
-        FLAT_VRS[side]
-            .iter()
-            .map(|f| {
-                let depth = val(f[1]);
-                FlatSpec {
-                    length: val(f[0]),
-                    depth: if depth == 0.0 { None } else { Some(depth) },
-                    angle: val(f[2]),
-                    shape: if val(f[3]) == enums::flat_shape::CHORD {
-                        FlatShape::Chord
-                    } else {
-                        FlatShape::Haversine
-                    },
-                }
-            })
-            .collect::<Vec<_>>()
-    });
+    let flats_of = |vrs: &[[[u32; 4]; 4]; 2]| {
+        [0, 1].map(|side| vrs[side].iter().map(|f| flat(v, f)).collect::<Vec<_>>())
+    };
+    let flats = flats_of(&FLAT_VRS);
+    let wheelsets = val(vr::WHEELSETS) as usize;
+    let trailing = (0..wheelsets.saturating_sub(1).min(TRAILING))
+        .map(|k| TrailingWheelset {
+            offset: val(OFFSET_VRS[k]),
+            flats: flats_of(&TRAILING_FLAT_VRS[k]),
+        })
+        .collect();
+    let sites = SITE_POSITION_VRS[..(val(vr::SITES) as usize).min(SITE_POSITION_VRS.len())]
+        .iter()
+        .map(|&r| val(r))
+        .collect();
     let vehicle = match kind {
         Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
         _ => VehicleSpec::External {
@@ -113,8 +129,8 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         speed: val(vr::SPEED),
         start_position: val(vr::START_POSITION),
         dt: val(vr::SOLVER_DT),
-        sites: Vec::new(),
-        trailing: Vec::new(),
+        sites,
+        trailing,
         window: (val(vr::TRACK_WINDOW_AHEAD) > 0.0).then(|| TrackWindow {
             ahead: val(vr::TRACK_WINDOW_AHEAD),
             behind: val(vr::TRACK_WINDOW_BEHIND),

@@ -7,7 +7,7 @@ use super::outputs::Published;
 use super::parameters::{scenario, vehicle_unit_params};
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
-use crate::fmu::vars::{FmuTable, VarSpec, vr};
+use crate::fmu::vars::{FmuTable, TRAILING, TRAILING_INPUT_VRS, VarSpec, vr};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
 use crate::sim::{Sample, Simulation, TrackSpec, VehicleUnit};
 
@@ -75,7 +75,7 @@ impl FmuModel {
 }
 
 impl Model for FmuModel {
-    const CALCULATED: usize = 7;
+    const CALCULATED: usize = Published::LEN;
 
     fn build(table: &'static FmuTable, values: &[f64]) -> Result<Self, Error> {
         let kind = Kind::from_guid(table.guid).ok_or_else(|| {
@@ -88,6 +88,7 @@ impl Model for FmuModel {
                 let published = Published {
                     static_load: u.static_load(),
                     static_wheel_z: p.static_wheel_z,
+                    trailing_static_wheel_z: [[0.0; 2]; TRAILING],
                     step: u.dt_base(),
                     critical_step: p.vehicle.critical_time_step(),
                     kw_used: 0.0,
@@ -96,9 +97,16 @@ impl Model for FmuModel {
             }
             Kind::TrackContact | Kind::CoupledSystem => {
                 let sim = Simulation::new(&scenario(kind, values))?;
+                let mut trailing_static_wheel_z = [[0.0; 2]; TRAILING];
+                for (z, k) in trailing_static_wheel_z.iter_mut().zip(1..) {
+                    if let Some(s) = sim.sample_of(k) {
+                        *z = s.wheel_z;
+                    }
+                }
                 let published = Published {
                     static_load: sim.static_load(),
                     static_wheel_z: sim.wheel_z(),
+                    trailing_static_wheel_z,
                     step: sim.dt(),
                     critical_step: sim.critical_step(),
                     kw_used: sim.contact_law().kw,
@@ -132,15 +140,20 @@ impl Model for FmuModel {
                 if kind != Kind::TrackContact {
                     return Ok(());
                 }
-                let rotation = changed.contains(&vr::WHEEL_ROTATION);
-                let heights = changed
-                    .iter()
-                    .any(|&r| r == vr::WHEEL_LEFT_Z || r == vr::WHEEL_RIGHT_Z);
-                if heights {
-                    sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
-                }
-                if rotation {
-                    sim.set_rotation(v(vr::WHEEL_ROTATION))?;
+                let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
+                let inputs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
+                for (k, [left, right, rotation]) in inputs.enumerate() {
+                    if k >= sim.wheelsets().len() {
+                        // The inputs of a wheelset the model does not have are kept
+                        // and unused.
+                        break;
+                    }
+                    if changed.iter().any(|&r| r == left || r == right) {
+                        sim.set_wheel_z_of(k, [v(left), v(right)])?;
+                    }
+                    if changed.contains(&rotation) {
+                        sim.set_rotation_of(k, v(rotation))?;
+                    }
                 }
                 Ok(())
             }
@@ -148,6 +161,28 @@ impl Model for FmuModel {
                 u.set_forces([v(vr::CONTACT_LEFT_FORCE), v(vr::CONTACT_RIGHT_FORCE)])
             }
         }
+    }
+
+    /// TrackContact's wheel heights not set by the master: the static heights of the
+    /// wheelset's wheels, so that an unconnected wheel starts at rest.
+    fn input_at_rest(&self, r: u32) -> Option<f64> {
+        let sim = self.simulation()?;
+        if self.kind != Kind::TrackContact {
+            return None;
+        }
+        let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
+        let inputs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
+        for (k, [left, right, _]) in inputs.enumerate() {
+            let side = if r == left {
+                0
+            } else if r == right {
+                1
+            } else {
+                continue;
+            };
+            return sim.sample_of(k).map(|s| s.wheel_z[side]);
+        }
+        None
     }
 
     type Outputs = Option<Sample>;

@@ -20,6 +20,9 @@ pub struct Instance<M: Model> {
     pub(super) model: Option<M>,
     /// Parameters changed since the model was built.
     pub(super) dirty: bool,
+    /// The inputs the master has set since instantiation or reset, by value reference:
+    /// a model is built with these; the others take [`Model::input_at_rest`].
+    pub(super) given: Vec<bool>,
     /// The calculated parameters of the last model built ([`Model::calculated`]).
     pub(super) calculated: Vec<f64>,
     /// Communication time (s): the master's clock, as its `fmi2DoStep` calls carry it.
@@ -69,6 +72,7 @@ impl<M: Model> Instance<M> {
             phase: Phase::Instantiated,
             model: None,
             dirty: true,
+            given: vec![false; N_VR],
             calculated: vec![0.0; M::CALCULATED],
             time: 0.0,
             start_time: 0.0,
@@ -316,6 +320,7 @@ impl<M: Model> Instance<M> {
         self.phase = Phase::Instantiated;
         self.model = None;
         self.dirty = true;
+        self.given.iter_mut().for_each(|g| *g = false);
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;
@@ -345,8 +350,18 @@ impl<M: Model> Instance<M> {
                     self.model = Some(m);
                     self.dirty = false;
                     self.log_event(|| "model built: static equilibrium solved".into());
-                    let inputs: Vec<u32> = self.table.inputs().collect();
-                    self.sync_inputs(&inputs)?;
+                    // The inputs the master gave go to the model; the others report
+                    // where the model put them.
+                    let (given, at_rest): (Vec<u32>, Vec<u32>) =
+                        self.table.inputs().partition(|&r| self.given[r as usize]);
+                    if let Some(m) = &self.model {
+                        for r in at_rest {
+                            if let Some(x) = m.input_at_rest(r) {
+                                self.values[r as usize] = x;
+                            }
+                        }
+                    }
+                    self.sync_inputs(&given)?;
                 }
                 Err(e) => {
                     self.model = None;

@@ -67,6 +67,14 @@ pub trait Model: Clone + Sized {
     /// Hands the model the inputs `changed` (value references) from `values`.
     fn set_inputs(&mut self, values: &[f64], changed: &[u32]) -> Result<(), Error>;
 
+    /// The value the model built itself for input `vr`, which the master has not set:
+    /// where the model's own initial state puts it (a wheel height at rest in static
+    /// equilibrium, say). `None` takes the input's start value. The layer reports it
+    /// as the input's value.
+    fn input_at_rest(&self, _vr: u32) -> Option<f64> {
+        None
+    }
+
     /// What the outputs of one read are computed from (evaluated once per read call).
     type Outputs;
 

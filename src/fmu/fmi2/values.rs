@@ -189,6 +189,15 @@ impl<M: Model> Instance<M> {
         for (&r, &x) in vrs.iter().zip(vals) {
             self.values[r as usize] = x;
         }
+        if inputs {
+            for &r in vrs {
+                if let Some(i) = self.slot[r as usize]
+                    && self.table.vars[i].causality == Causality::Input
+                {
+                    self.given[r as usize] = true;
+                }
+            }
+        }
         self.dirty |= parameters;
         if sync && let Err(e) = self.sync_inputs(vrs) {
             for (&r, &x) in vrs.iter().zip(before) {

@@ -186,9 +186,9 @@ fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
     };
     let guid = i.table().guid.len();
     let time_at = MAGIC.len() + 8 + guid + 3;
-    // time, start time, the reason's length (0), seven calculated parameters, the
-    // value count
-    let values_at = time_at + 8 * 10 + 8;
+    // time, start time, the reason's length (0), the calculated parameters (seven and
+    // two static wheel heights per trailing wheelset), the value count
+    let values_at = time_at + 8 * (3 + 7 + 2 * crate::fmu::vars::TRAILING) + 8;
     for (at, x, why) in [
         (b.len() - 8, f64::NAN, "model state"),
         (b.len() - 8, f64::INFINITY, "model state"),
