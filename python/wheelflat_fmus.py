@@ -173,5 +173,71 @@ def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params
         vehicle.close()
 
 
+def trailing(k, names):
+    """The names of wheelset k (2, 3, ..) for the leading wheelset's `names`."""
+    return tuple(f"wheelset[{k}].{n}" for n in names)
+
+
+def run_bogie(paths, stop_time, wheelsets=2, track_params=None, vehicle_params=None):
+    """Couples one TrackContact carrying `wheelsets` wheelsets with one vehicle model per
+    wheelset (here RollPlaneVehicle instances, where a third-party bogie model would
+    give each wheelset's wheel heights and axle rotation and take its contact forces),
+    at the track's internal step. The handshake is the pair's, per wheelset: the
+    static loads of the (identical) vehicles to the track, each wheelset's static
+    wheel heights (``static_wheel_z.*``, ``wheelset[k].static_wheel_z.*``) back to its
+    vehicle. Returns a dict of lists: time, and per wheelset k (1 the leading one) its
+    left and right contact force as ``force[k].left``/``.right``."""
+    params = dict(track_params or {})
+    params["wheelsets"] = wheelsets
+    track = Unit(paths["TrackContact"], "track")
+    vehicles = [Unit(paths["RollPlaneVehicle"], f"vehicle{k}") for k in range(1, wheelsets + 1)]
+    names = [(WHEELS, FORCES, ("static_wheel_z.left", "static_wheel_z.right"))] + [
+        (trailing(k, WHEELS), trailing(k, FORCES), trailing(k, ("static_wheel_z.left", "static_wheel_z.right")))
+        for k in range(2, wheelsets + 1)]
+    try:
+        for u in [track] + vehicles:
+            u.fmu.setupExperiment(startTime=0.0)
+        track.set_parameters(params)
+        for v in vehicles:
+            v.set_parameters(vehicle_params)
+            v.fmu.enterInitializationMode()
+        track.fmu.enterInitializationMode()
+        loads = ("static_load.left", "static_load.right")
+        track.set(loads, vehicles[0].get(*loads))
+        for v, (wheels, forces, heights) in zip(vehicles, names):
+            v.set(("static_wheel_z.left", "static_wheel_z.right"), track.get(*heights))
+            track.set(wheels, v.get(*WHEELS))
+        for v, (wheels, forces, heights) in zip(vehicles, names):
+            v.set(FORCES, track.get(*forces))
+            v.fmu.exitInitializationMode()
+        track.fmu.exitInitializationMode()
+        h = track.get("solver.step")[0]
+        n = int(round(stop_time / h))
+        out = {"time": []}
+        for k in range(1, wheelsets + 1):
+            out[f"force[{k}].left"], out[f"force[{k}].right"] = [], []
+        t = 0.0
+        for step in range(n + 1):
+            for v, (wheels, _, _) in zip(vehicles, names):
+                track.set(wheels, v.get(*WHEELS))
+            out["time"].append(t)
+            for k, (v, (_, forces, _)) in enumerate(zip(vehicles, names), 1):
+                p = track.get(*forces)
+                v.set(FORCES, p)
+                out[f"force[{k}].left"].append(p[0])
+                out[f"force[{k}].right"].append(p[1])
+            if step == n:
+                break
+            track.fmu.doStep(t, h)
+            for v in vehicles:
+                v.fmu.doStep(t, h)
+            t = (step + 1) * h
+        return out
+    finally:
+        track.close()
+        for v in vehicles:
+            v.close()
+
+
 if __name__ == "__main__":
     install_venv()

@@ -703,3 +703,69 @@ def test_a_speed_input_brakes_the_coupled_system_to_standstill(paths):
     assert travelled == pytest.approx(v0 ** 2 / (2 * a), rel=0.01)
     assert r["position"][-1] == r["position"][-200]
     assert r["contact.left.force"][-1] == pytest.approx(r["static_load.left"][-1], rel=0.01)
+
+
+# ------------------------------------------------------------------ wheelsets and sites
+
+def test_a_bogie_on_one_track_contact_equals_coupled_system_with_two_wheelsets(paths):
+    # python/bogie_coupling.py's recipe: one TrackContact with two wheelsets, a vehicle
+    # unit per wheelset, at the track's step, against CoupledSystem with wheelsets = 2:
+    # the same numbers to the bit; and on shared rails the rear wheelset feels the
+    # front wheelset's impact (the issue measured 82 to 187 kN).
+    track = {"track.window.ahead": 20.0, "wheelset[2].offset": 1.8}
+    r = wf.run_bogie(paths, 0.15, wheelsets=2, track_params=track)
+    dt = wf.track_step(paths, track)
+    outputs = ["contact.left.force", "contact.right.force", "wheelset[2].contact.left.force",
+               "wheelset[2].contact.right.force"]
+    c = simulate_fmu(paths["CoupledSystem"], stop_time=0.15, step_size=dt, output_interval=dt,
+                     start_values=dict(track, wheelsets=2), output=outputs)
+    n = min(len(r["time"]), len(c["time"]))
+    assert n > 10000
+    for name, out in zip(["force[1].left", "force[1].right", "force[2].left", "force[2].right"], outputs):
+        assert np.array_equal(np.asarray(r[name][:n]), np.asarray(c[out][:n])), name
+    rear = np.asarray(r["force[2].left"])
+    assert rear.max() > 1.6 * 107.66e3 and rear.min() < 0.8 * 107.66e3
+
+
+def test_wheelsets_beyond_the_count_read_zero_and_take_inputs_unused(paths):
+    # Wheels the master has not set start at rest on their static heights.
+    u = initialised(paths, "TrackContact", params={"wheelsets": 2, "track.window.ahead": 20.0})
+    assert u.get("wheelset[2].contact.left.force")[0] == pytest.approx(107664.75, rel=1e-9)
+    assert u.get("contact.left.force")[0] == pytest.approx(107664.75, rel=1e-9)
+    assert u.get("wheelset[2].wheel.left.z") == u.get("wheelset[2].static_wheel_z.left")
+    assert u.get("wheelset[2].position")[0] == pytest.approx(1.37 - 1.8, abs=1e-12)
+    assert u.get("wheelset[3].contact.left.force", "wheelset[3].position") == [0.0, 0.0]
+    u.set(["wheelset[3].wheel.left.z"], [-0.002])
+    u.fmu.doStep(0.0, 1e-4)
+    assert u.get("wheelset[3].contact.left.force")[0] == 0.0
+    u.close()
+
+
+def test_a_site_under_the_wheel_reads_the_rail_under_the_wheel_and_the_runners_extremes(paths):
+    # A site where the wheel starts reads at t = 0 what the outputs under the wheel
+    # read (two code paths, one place); over 0.5 s its extremes equal the runner's
+    # `--site` report (printed to 0.1 kN), and a site beyond `sites` reads 0.
+    u = initialised(paths, "CoupledSystem", params={"sites": 2, "site[1].position": 1.37,
+                                                     "site[2].position": 8.22})
+    now = u.get("site[1].rail.left.z", "site[1].rail.left.bending_moment")
+    under = u.get("rail.left.z", "rail.left.bending_moment")
+    assert now == pytest.approx(under, rel=1e-12)
+    h = u.get("solver.step")[0]
+    n = int(round(0.5 / h))
+    for k in range(n):
+        u.fmu.doStep(k * h, h)
+    got = u.get("site[2].seat.left.force.max", "site[2].rail.left.bending_moment.max",
+                "site[2].ballast.left.force.max", "site[2].seat.right.force.max")
+    assert u.get("site[3].seat.left.force.max")[0] == 0.0
+    u.close()
+    out = subprocess.run([os.path.join(wf.TARGET_DIR, "release", "wheelflat"), "--site", "8.22", "--duration",
+                          "0.5", "--output", os.devnull], check=True, capture_output=True, cwd=wf.ROOT,
+                         text=True).stdout
+    line = next(x for x in out.splitlines() if x.startswith("site at 8.220 m"))
+    import re
+    nums = [float(x) for x in re.findall(r"(\d+\.\d) kN", line)]
+    # left seat, moment (kN m), shear, ballast; right seat, moment, shear, ballast
+    assert got[0] / 1e3 == pytest.approx(nums[0], abs=0.051)
+    assert got[2] / 1e3 == pytest.approx(nums[3], abs=0.051)
+    assert got[3] / 1e3 == pytest.approx(nums[4], abs=0.051)
+    assert got[0] > 120e3  # the impact near this sleeper
