@@ -210,7 +210,81 @@ fn endless_track(c: &mut Criterion) {
             |b, sim| b.iter(|| run_for(sim, 1.0)),
         );
     }
+    // The same through the C boundary: CoupledSystem on the default window with 1 and 4
+    // wheelsets, one fmi2DoStep of solver.step per step (its overhead over the engine).
+    for w in [1usize, 4] {
+        let comp = coupled_system_on_window(w);
+        g.bench_with_input(
+            BenchmarkId::new("coupled_system_fmu_wheelsets", w),
+            &comp,
+            |b, comp| b.iter(|| fmu_run(comp.0, comp.1, comp.2, 1.0)),
+        );
+    }
     g.finish();
+}
+
+/// An initialised CoupledSystem instance on the default window with `wheelsets`
+/// wheelsets (the wagon's), its FMU state there, and its step (s).
+fn coupled_system_on_window(
+    wheelsets: usize,
+) -> (
+    wheelflat::fmu::ffi::fmi2Component,
+    wheelflat::fmu::ffi::fmi2FMUstate,
+    f64,
+) {
+    use std::ffi::CString;
+    use wheelflat::fmu::ffi::*;
+    use wheelflat::fmu::vars::{COUPLED_SYSTEM, OFFSET_VRS, vr};
+    let cb = fmi2CallbackFunctions {
+        logger: None,
+        allocateMemory: None,
+        freeMemory: None,
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    };
+    let guid = CString::new(COUPLED_SYSTEM.guid).unwrap();
+    let comp =
+        unsafe { fmi2Instantiate(c"bench".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0) };
+    assert!(!comp.is_null());
+    let mut state: fmi2FMUstate = std::ptr::null_mut();
+    let mut dt = 0.0;
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(comp, 0, 0.0, 0.0, 0, 0.0), 0);
+        let side = TrackWindow::DEFAULT.ahead;
+        assert_eq!(fmi2SetReal(comp, &vr::TRACK_WINDOW_AHEAD, 1, &side), 0);
+        let n = wheelsets as i32;
+        assert_eq!(fmi2SetInteger(comp, &vr::WHEELSETS, 1, &n), 0);
+        for (r, d) in OFFSET_VRS.iter().zip(WAGON) {
+            assert_eq!(fmi2SetReal(comp, r, 1, &d), 0);
+        }
+        assert_eq!(fmi2EnterInitializationMode(comp), 0);
+        assert_eq!(fmi2ExitInitializationMode(comp), 0);
+        assert_eq!(fmi2GetReal(comp, &vr::SOLVER_STEP, 1, &mut dt), 0);
+        assert_eq!(fmi2GetFMUstate(comp, &mut state), 0);
+    }
+    (comp, state, dt)
+}
+
+/// `time` (s) of fmi2DoStep calls of `dt` from the FMU state `state`, the contact
+/// forces read after each.
+fn fmu_run(
+    comp: wheelflat::fmu::ffi::fmi2Component,
+    state: wheelflat::fmu::ffi::fmi2FMUstate,
+    dt: f64,
+    time: f64,
+) {
+    use wheelflat::fmu::ffi::*;
+    use wheelflat::fmu::vars::vr;
+    let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
+    unsafe {
+        assert_eq!(fmi2SetFMUstate(comp, state), 0);
+        let mut p = [0.0; 2];
+        for k in 0..(time / dt).round() as u64 {
+            fmi2DoStep(comp, k as f64 * dt, dt, 1);
+            fmi2GetReal(comp, outputs.as_ptr(), 2, p.as_mut_ptr());
+            black_box(p);
+        }
+    }
 }
 
 criterion_group!(

@@ -1,0 +1,76 @@
+//! Cost of one step of CoupledSystem on the endless track's default window with 1 to 4
+//! wheelsets of a four-axle wagon (0, 1.8, 10, 11.8 m), through the C boundary
+//! (fmi2DoStep of solver.step, the contact forces read) against the engine's own step
+//! of the same scenario, for instruction counting:
+//! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS`
+//! (subtract a run of 0 steps). Without valgrind it prints wall time per step.
+
+use std::ffi::CString;
+use std::hint::black_box;
+use std::time::Instant;
+use wheelflat::fmu::ffi::*;
+use wheelflat::fmu::vars::{COUPLED_SYSTEM, OFFSET_VRS, vr};
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
+
+const WAGON: [f64; 3] = [1.8, 10.0, 11.8];
+
+fn main() {
+    let arg = |k: usize| std::env::args().nth(k);
+    let which = arg(1).unwrap_or_else(|| "both".into());
+    let wheelsets: usize = arg(2).and_then(|s| s.parse().ok()).unwrap_or(1);
+    let n: u64 = arg(3).and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    let mut s = Scenario::table_4_4_flat();
+    s.window = Some(TrackWindow::DEFAULT);
+    s.trailing = WAGON[..wheelsets - 1]
+        .iter()
+        .map(|&offset| TrailingWheelset {
+            offset,
+            ..Default::default()
+        })
+        .collect();
+    if which == "engine" || which == "both" {
+        let mut e = Simulation::new(&s).unwrap();
+        let t0 = Instant::now();
+        for _ in 0..n {
+            black_box(e.step().as_ref().unwrap());
+        }
+        let w = t0.elapsed().as_secs_f64() / n as f64;
+        println!("engine step, {wheelsets} wheelsets: {:.3} us", w * 1e6);
+    }
+    if which == "fmu" || which == "both" {
+        let cb = fmi2CallbackFunctions {
+            logger: None,
+            allocateMemory: None,
+            freeMemory: None,
+            stepFinished: None,
+            componentEnvironment: std::ptr::null_mut(),
+        };
+        let guid = CString::new(COUPLED_SYSTEM.guid).unwrap();
+        let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
+        unsafe {
+            let c = fmi2Instantiate(c"cost".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0);
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
+            let side = TrackWindow::DEFAULT.ahead;
+            assert_eq!(fmi2SetReal(c, &vr::TRACK_WINDOW_AHEAD, 1, &side), 0);
+            let count = wheelsets as i32;
+            assert_eq!(fmi2SetInteger(c, &vr::WHEELSETS, 1, &count), 0);
+            for (r, d) in OFFSET_VRS.iter().zip(WAGON) {
+                assert_eq!(fmi2SetReal(c, r, 1, &d), 0);
+            }
+            assert_eq!(fmi2EnterInitializationMode(c), 0);
+            assert_eq!(fmi2ExitInitializationMode(c), 0);
+            let mut dt = 0.0;
+            assert_eq!(fmi2GetReal(c, &vr::SOLVER_STEP, 1, &mut dt), 0);
+            let mut p = [0.0; 2];
+            let t0 = Instant::now();
+            for k in 0..n {
+                assert_eq!(fmi2DoStep(c, k as f64 * dt, dt, 1), 0);
+                fmi2GetReal(c, outputs.as_ptr(), 2, p.as_mut_ptr());
+                black_box(p);
+            }
+            let w = t0.elapsed().as_secs_f64() / n as f64;
+            println!("CoupledSystem step, {wheelsets} wheelsets: {:.3} us", w * 1e6);
+            fmi2FreeInstance(c);
+        }
+    }
+}
