@@ -727,6 +727,17 @@ def test_a_bogie_on_one_track_contact_equals_coupled_system_with_two_wheelsets(p
     assert rear.max() > 1.6 * 107.66e3 and rear.min() < 0.8 * 107.66e3
 
 
+@pytest.mark.parametrize("name", ["TrackContact", "CoupledSystem"])
+def test_the_leading_wheelsets_initial_values_declare_the_other_wheelsets(paths, name):
+    # The trailing wheelsets' loads bend the rails under the leading one: its static
+    # heights and forces depend on wheelsets and the offsets, and say so.
+    from fmpy import read_model_description
+    md = read_model_description(paths[name])
+    deps = {u.variable.name: {d.name for d in (u.dependencies or [])} for u in md.initialUnknowns}
+    for v in ["static_wheel_z.left", "contact.left.force", "rail.right.z"]:
+        assert {"wheelsets", "wheelset[2].offset", "wheelset[4].offset"} <= deps[v], (v, deps[v])
+
+
 def test_wheelsets_beyond_the_count_read_zero_and_take_inputs_unused(paths):
     # Wheels the master has not set start at rest on their static heights.
     u = initialised(paths, "TrackContact", params={"wheelsets": 2, "track.window.ahead": 20.0})

@@ -281,6 +281,15 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
     assert_eq!(name(&s), "wheelsets");
     s.trailing = vec![trailing(30.0)];
     assert_eq!(name(&s), "start_position");
+    // A flat of a trailing wheelset is named with its wheelset.
+    let mut t = trailing(1.8);
+    t.flats[0].push(wheelflat::wheel::FlatSpec::haversine(0.1, 0.05, 0.0));
+    s.trailing = vec![t];
+    assert!(
+        name(&s).starts_with("wheelset[2].flat.left[1]"),
+        "{}",
+        name(&s)
+    );
     s.trailing.clear();
     s.window = Some(TrackWindow {
         ahead: 0.1,

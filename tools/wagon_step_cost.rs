@@ -69,7 +69,10 @@ fn main() {
                 black_box(p);
             }
             let w = t0.elapsed().as_secs_f64() / n as f64;
-            println!("CoupledSystem step, {wheelsets} wheelsets: {:.3} us", w * 1e6);
+            println!(
+                "CoupledSystem step, {wheelsets} wheelsets: {:.3} us",
+                w * 1e6
+            );
             fmi2FreeInstance(c);
         }
     }

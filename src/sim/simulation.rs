@@ -389,11 +389,15 @@ impl Simulation {
                 },
             })
         };
-        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?)?;
+        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?;
         let trailing = s
             .trailing
             .iter()
-            .map(|w| Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?))
+            .zip(2..)
+            .map(|(w, k)| {
+                let name = format!("wheelset[{k}].");
+                Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?, &name)
+            })
             .collect::<Result<Vec<_>>>()?;
         let wheelsets = Wheelsets::new(lead, trailing);
         let origin = window.map_or(0.0, |w: Window| {
@@ -411,7 +415,8 @@ impl Simulation {
                             s.start_position,
                             format!(
                                 "every wheelset inside the track, 0 < x < {len} m (wheelset at \
-                                 {} m behind the leading one: {} m)",
+                                 {} m behind the leading one: {} m; an endless track, \
+                                 track.window.ahead > 0, carries wheelsets anywhere)",
                                 num(w.offset()),
                                 num(x)
                             ),

@@ -124,14 +124,19 @@ pub(crate) fn sites(
     let len = track.params().length();
     positions
         .iter()
-        .map(|&x| {
+        .enumerate()
+        .map(|(j, &x)| {
+            let name = format!("site[{}].position", j + 1);
             if endless {
-                crate::error::finite("site position", x, "m")?;
+                crate::error::finite(&name, x, "m")?;
             } else if !(x > 0.0 && x < len) {
                 return Err(out_of_range(
-                    "site position",
+                    &name,
                     x,
-                    format!("0 m < site position < {len} m (the track)"),
+                    format!(
+                        "0 m < {name} < {len} m (on the fixed track; an endless track, \
+                         track.window.ahead > 0, takes any position)"
+                    ),
                 ));
             }
             let now = Site::read(track, origin, x);

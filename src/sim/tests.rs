@@ -352,5 +352,5 @@ fn sites_restore_with_the_state_and_are_checked() {
     assert!(e.contains("at most 8"), "{e}");
     s.sites = vec![25.0];
     let e = Simulation::new(&s).unwrap_err().to_string();
-    assert!(e.contains("site position") && e.contains("20.55"), "{e}");
+    assert!(e.contains("site[1].position") && e.contains("20.55"), "{e}");
 }

@@ -51,18 +51,20 @@ impl Wheelset {
     /// radius `radius` (m) and the flats `flats` `[left, right]`, moved by `vehicle`.
     ///
     /// Errors: `offset` negative or not finite; a radius or flat that
-    /// [`WheelProfile::new`] refuses (named `flat.left` or `flat.right`).
+    /// [`WheelProfile::new`] refuses (named `{name}flat.left` or `{name}flat.right`:
+    /// `name` is `""` for the leading wheelset, `"wheelset[k]."` for wheelset k).
     pub fn new(
         radius: f64,
         flats: &[Vec<FlatSpec>; 2],
         offset: f64,
         vehicle: VehicleState,
+        name: &str,
     ) -> Result<Wheelset> {
-        non_negative("wheelset.offset", offset, "m")?;
+        non_negative(&format!("{name}offset"), offset, "m")?;
         Ok(Wheelset {
             wheels: [
-                WheelProfile::new(radius, &flats[0], "flat.left")?,
-                WheelProfile::new(radius, &flats[1], "flat.right")?,
+                WheelProfile::new(radius, &flats[0], &format!("{name}flat.left"))?,
+                WheelProfile::new(radius, &flats[1], &format!("{name}flat.right"))?,
             ],
             offset,
             vehicle,

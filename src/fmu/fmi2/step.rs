@@ -57,7 +57,10 @@ impl<M: Model> Instance<M> {
             return self.refuse(
                 Status::Error,
                 format!(
-                    "fmi2DoStep: t + h = {end} s is past stopTime = {stop} s of fmi2SetupExperiment"
+                    "fmi2DoStep: t + h = {end} s is past stopTime = {stop} s of \
+                     fmi2SetupExperiment; the last step must end at stopTime or before it (take \
+                     floor((stopTime - startTime) / h) steps and a shorter last one), or give a \
+                     later stopTime or none"
                 ),
             );
         }
