@@ -4,6 +4,9 @@
 //! and n; contact evaluation with and without a flat in the patch.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+
+#[path = "../tools/ffi_instance.rs"]
+mod ffi_instance;
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
@@ -98,7 +101,6 @@ fn contact(c: &mut Criterion) {
 /// inputs, read the contact forces, step: what a master does each step), against the
 /// engine stepping the same track with the same held wheels.
 fn fmu_step(c: &mut Criterion) {
-    use std::ffi::CString;
     use wheelflat::fmu::ffi::*;
     use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
     use wheelflat::sim::VehicleSpec;
@@ -125,22 +127,9 @@ fn fmu_step(c: &mut Criterion) {
         })
     });
     // The FMU.
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
-    let guid = CString::new(TRACK_CONTACT.guid).unwrap();
-    let comp =
-        unsafe { fmi2Instantiate(c"bench".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0) };
-    assert!(!comp.is_null());
+    let (comp, _) = ffi_instance::initialised(TRACK_CONTACT.guid, &[], &[]);
     let mut state: fmi2FMUstate = std::ptr::null_mut();
     unsafe {
-        assert_eq!(fmi2SetupExperiment(comp, 0, 0.0, 0.0, 0, 0.0), 0);
-        assert_eq!(fmi2EnterInitializationMode(comp), 0);
-        assert_eq!(fmi2ExitInitializationMode(comp), 0);
         assert_eq!(fmi2GetFMUstate(comp, &mut state), 0);
     }
     let inputs = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
@@ -232,34 +221,17 @@ fn coupled_system_on_window(
     wheelflat::fmu::ffi::fmi2FMUstate,
     f64,
 ) {
-    use std::ffi::CString;
     use wheelflat::fmu::ffi::*;
     use wheelflat::fmu::vars::{COUPLED_SYSTEM, OFFSET_VRS, vr};
-    let cb = fmi2CallbackFunctions {
-        logger: None,
-        allocateMemory: None,
-        freeMemory: None,
-        stepFinished: None,
-        componentEnvironment: std::ptr::null_mut(),
-    };
-    let guid = CString::new(COUPLED_SYSTEM.guid).unwrap();
-    let comp =
-        unsafe { fmi2Instantiate(c"bench".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0) };
-    assert!(!comp.is_null());
+    let mut reals = vec![(vr::TRACK_WINDOW_AHEAD, TrackWindow::DEFAULT.ahead)];
+    reals.extend(OFFSET_VRS.iter().copied().zip(WAGON));
+    let (comp, dt) = ffi_instance::initialised(
+        COUPLED_SYSTEM.guid,
+        &reals,
+        &[(vr::WHEELSETS, wheelsets as i32)],
+    );
     let mut state: fmi2FMUstate = std::ptr::null_mut();
-    let mut dt = 0.0;
     unsafe {
-        assert_eq!(fmi2SetupExperiment(comp, 0, 0.0, 0.0, 0, 0.0), 0);
-        let side = TrackWindow::DEFAULT.ahead;
-        assert_eq!(fmi2SetReal(comp, &vr::TRACK_WINDOW_AHEAD, 1, &side), 0);
-        let n = wheelsets as i32;
-        assert_eq!(fmi2SetInteger(comp, &vr::WHEELSETS, 1, &n), 0);
-        for (r, d) in OFFSET_VRS.iter().zip(WAGON) {
-            assert_eq!(fmi2SetReal(comp, r, 1, &d), 0);
-        }
-        assert_eq!(fmi2EnterInitializationMode(comp), 0);
-        assert_eq!(fmi2ExitInitializationMode(comp), 0);
-        assert_eq!(fmi2GetReal(comp, &vr::SOLVER_STEP, 1, &mut dt), 0);
         assert_eq!(fmi2GetFMUstate(comp, &mut state), 0);
     }
     (comp, state, dt)

@@ -3,12 +3,14 @@
 //! instruction counting: `valgrind --tool=callgrind target/release/examples/fmu_step_cost engine|fmu [steps]`.
 //! Without valgrind it prints wall time per step.
 
-use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 use wheelflat::fmu::ffi::*;
 use wheelflat::fmu::vars::{TRACK_CONTACT, vr};
 use wheelflat::sim::{Scenario, Simulation, VehicleSpec};
+
+#[path = "ffi_instance.rs"]
+mod ffi_instance;
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_else(|| "both".into());
@@ -34,21 +36,10 @@ fn main() {
         println!("engine step: {:.3} us", w * 1e6);
     }
     if which == "fmu" || which == "both" {
-        let cb = fmi2CallbackFunctions {
-            logger: None,
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        };
-        let guid = CString::new(TRACK_CONTACT.guid).unwrap();
+        let (c, _) = ffi_instance::initialised(TRACK_CONTACT.guid, &[], &[]);
         let inputs = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
         let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
         unsafe {
-            let c = fmi2Instantiate(c"cost".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0);
-            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
-            assert_eq!(fmi2EnterInitializationMode(c), 0);
-            assert_eq!(fmi2ExitInitializationMode(c), 0);
             let mut p = [0.0; 2];
             let t0 = Instant::now();
             for k in 0..n {

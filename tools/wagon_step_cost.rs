@@ -5,12 +5,14 @@
 //! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS`
 //! (subtract a run of 0 steps). Without valgrind it prints wall time per step.
 
-use std::ffi::CString;
 use std::hint::black_box;
 use std::time::Instant;
 use wheelflat::fmu::ffi::*;
 use wheelflat::fmu::vars::{COUPLED_SYSTEM, OFFSET_VRS, vr};
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
+
+#[path = "ffi_instance.rs"]
+mod ffi_instance;
 
 const WAGON: [f64; 3] = [1.8, 10.0, 11.8];
 
@@ -38,29 +40,12 @@ fn main() {
         println!("engine step, {wheelsets} wheelsets: {:.3} us", w * 1e6);
     }
     if which == "fmu" || which == "both" {
-        let cb = fmi2CallbackFunctions {
-            logger: None,
-            allocateMemory: None,
-            freeMemory: None,
-            stepFinished: None,
-            componentEnvironment: std::ptr::null_mut(),
-        };
-        let guid = CString::new(COUPLED_SYSTEM.guid).unwrap();
+        let mut reals = vec![(vr::TRACK_WINDOW_AHEAD, TrackWindow::DEFAULT.ahead)];
+        reals.extend(OFFSET_VRS.iter().copied().zip(WAGON));
+        let integers = [(vr::WHEELSETS, wheelsets as i32)];
+        let (c, dt) = ffi_instance::initialised(COUPLED_SYSTEM.guid, &reals, &integers);
         let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
         unsafe {
-            let c = fmi2Instantiate(c"cost".as_ptr(), 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0);
-            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
-            let side = TrackWindow::DEFAULT.ahead;
-            assert_eq!(fmi2SetReal(c, &vr::TRACK_WINDOW_AHEAD, 1, &side), 0);
-            let count = wheelsets as i32;
-            assert_eq!(fmi2SetInteger(c, &vr::WHEELSETS, 1, &count), 0);
-            for (r, d) in OFFSET_VRS.iter().zip(WAGON) {
-                assert_eq!(fmi2SetReal(c, r, 1, &d), 0);
-            }
-            assert_eq!(fmi2EnterInitializationMode(c), 0);
-            assert_eq!(fmi2ExitInitializationMode(c), 0);
-            let mut dt = 0.0;
-            assert_eq!(fmi2GetReal(c, &vr::SOLVER_STEP, 1, &mut dt), 0);
             let mut p = [0.0; 2];
             let t0 = Instant::now();
             for k in 0..n {

@@ -140,15 +140,18 @@ impl Model for FmuModel {
                 if kind != Kind::TrackContact {
                     return Ok(());
                 }
-                let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
-                let inputs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
-                for (k, [left, right, rotation]) in inputs.enumerate() {
-                    if k >= sim.wheelsets().len() {
-                        // The inputs of a wheelset the model does not have are kept
-                        // and unused.
-                        break;
-                    }
-                    if changed.iter().any(|&r| r == left || r == right) {
+                let changed_any = |a: u32, b: u32| changed.iter().any(|&r| r == a || r == b);
+                if changed_any(vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z) {
+                    sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
+                }
+                if changed.contains(&vr::WHEEL_ROTATION) {
+                    sim.set_rotation(v(vr::WHEEL_ROTATION))?;
+                }
+                // The wheelsets behind the leading one; the inputs of a wheelset the
+                // model does not have are kept and unused.
+                let n = sim.wheelsets().len();
+                for (k, &[left, right, rotation]) in (1..n).zip(&TRAILING_INPUT_VRS) {
+                    if changed_any(left, right) {
                         sim.set_wheel_z_of(k, [v(left), v(right)])?;
                     }
                     if changed.contains(&rotation) {

@@ -189,7 +189,11 @@ impl<M: Model> Instance<M> {
         for (&r, &x) in vrs.iter().zip(vals) {
             self.values[r as usize] = x;
         }
-        if inputs {
+        if inputs && !parameters {
+            for &r in vrs {
+                self.given[r as usize] = true;
+            }
+        } else if inputs {
             for &r in vrs {
                 if let Some(i) = self.slot[r as usize]
                     && self.table.vars[i].causality == Causality::Input
