@@ -28,9 +28,12 @@ impl Simulation {
             }
         }
         for (k, w) in self.wheelsets.iter().enumerate() {
-            if let VehicleState::RollPlane(v) = &w.vehicle
-                && let Some((what, value, limit)) = v.beyond_bounds()
-            {
+            let beyond = match &w.vehicle {
+                VehicleState::RollPlane(v) => v.beyond_bounds(),
+                VehicleState::AxleBox { body, .. } => body.beyond_bounds(),
+                _ => None,
+            };
+            if let Some((what, value, limit)) = beyond {
                 return Err(Error::Diverged {
                     what: format!("vehicle {what}{}", Self::of_wheelset(k)),
                     value,

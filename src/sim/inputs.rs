@@ -99,6 +99,56 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets the axle-box (primary suspension) forces `[left, right]` (N, pressing the
+    /// wheelset down) of wheelset `k` (0 the leading one) of a simulation with
+    /// [`VehicleSpec::AxleBox`](super::VehicleSpec::AxleBox) wheelsets, held from now
+    /// until they are set again. Refused for any other vehicle, a wheelset the
+    /// simulation does not have, and a force not finite or beyond the force limit.
+    pub fn set_axle_box_forces_of(&mut self, k: usize, f: [f64; 2]) -> Result<()> {
+        let lim = self.force_limit;
+        for (name, x) in [
+            ("axle_box.left.force", f[0]),
+            ("axle_box.right.force", f[1]),
+        ] {
+            if !within(x, lim) {
+                return Err(out_of_range(
+                    name,
+                    x,
+                    format!("-{lim} N <= {name} <= {lim} N (the force limit)"),
+                ));
+            }
+        }
+        let n = self.wheelsets.len();
+        let w = self.wheelsets.get_mut(k).ok_or_else(|| {
+            out_of_range(
+                "wheelset index",
+                k as f64,
+                format!("0 to {} (the wheelsets of this simulation)", n - 1),
+            )
+        })?;
+        match &mut w.vehicle {
+            VehicleState::AxleBox { box_force, .. } => {
+                *box_force = f;
+                self.clear_cache();
+                Ok(())
+            }
+            _ => Err(Error::Unsupported(
+                "axle-box forces for a simulation whose wheelsets are not cut at the axle boxes"
+                    .into(),
+            )),
+        }
+    }
+
+    /// The axle boxes of wheelset `k` at `t_j`: displacements and velocities `[left,
+    /// right]` (m, m/s, velocities backward differences over the last step); `None` for
+    /// a wheelset the simulation does not have or not cut at its axle boxes.
+    pub fn axle_box_motion_of(&self, k: usize) -> Option<([f64; 2], [f64; 2])> {
+        match &self.wheelsets.get(k)?.vehicle {
+            VehicleState::AxleBox { body, .. } => Some((body.wheel_z(), body.box_velocity())),
+            _ => None,
+        }
+    }
+
     fn not_external() -> Error {
         Error::Unsupported("wheel inputs for a simulation that has its own vehicle".into())
     }

@@ -32,6 +32,13 @@ pub enum VehicleSpec {
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).
     ConstantLoad([f64; 2]),
+    /// The roll-plane vehicle's wheelsets on the track, cut at their axle boxes
+    /// ([`crate::vehicle::WheelsetBody`]): the bogie above them is a co-simulation
+    /// partner that sets each wheelset's primary (axle-box) forces
+    /// ([`crate::sim::Simulation::set_axle_box_forces_of`]) and reads the axle boxes'
+    /// motion ([`crate::sim::Simulation::axle_box_motion_of`]). The static loads are the
+    /// whole vehicle's.
+    AxleBox(RollPlaneParams),
     /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
     /// displacements and the axle angle are inputs
     /// ([`crate::sim::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`

@@ -42,6 +42,14 @@ pub enum VehicleState {
     LumpedWheels(LumpedWheels),
     /// Constant loads (N), no contact.
     ConstantLoad([f64; 2]),
+    /// The wheelset of the roll-plane vehicle, its bogie outside: the axle-box forces
+    /// `[left, right]` (N, pressing the wheelset down) are inputs held over each step.
+    AxleBox {
+        /// The wheelset.
+        body: crate::vehicle::WheelsetBody,
+        /// Axle-box forces `[left, right]` (N).
+        box_force: [f64; 2],
+    },
     /// Wheels moved from outside.
     External {
         /// Wheel-centre displacements `[left, right]` (m), inputs.
@@ -64,6 +72,7 @@ impl VehicleState {
             VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
             VehicleState::ConstantLoad(_) => None,
             VehicleState::External { wheel_z, .. } => Some(*wheel_z),
+            VehicleState::AxleBox { body, .. } => Some(body.wheel_z()),
         }
     }
 
@@ -73,6 +82,7 @@ impl VehicleState {
         match self {
             VehicleState::RollPlane(v) => v.step(p),
             VehicleState::LumpedWheels(v) => v.step(p),
+            VehicleState::AxleBox { body, box_force } => body.step(p, *box_force),
             VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
         }
     }
@@ -382,6 +392,10 @@ impl Simulation {
                     VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
                 }
                 VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
+                VehicleSpec::AxleBox(p) => VehicleState::AxleBox {
+                    body: crate::vehicle::WheelsetBody::new(p, dt)?,
+                    box_force: [0.0; 2],
+                },
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
@@ -1023,6 +1037,7 @@ impl Simulation {
         for w in self.wheelsets.iter_mut() {
             match &mut w.vehicle {
                 VehicleState::RollPlane(v) => v.change_dt(dt)?,
+                VehicleState::AxleBox { body, .. } => body.change_dt(dt)?,
                 VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
                 VehicleState::LumpedWheels(_) => {
                     return Err(Error::Unsupported(

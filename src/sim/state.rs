@@ -57,6 +57,11 @@ impl Simulation {
                 rotation,
                 since,
             } => vec![wheel_z[0], wheel_z[1], *rotation, *since],
+            VehicleState::AxleBox { body, box_force } => {
+                let mut v = body.state_vector();
+                v.extend(box_force);
+                v
+            }
             VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
         })
     }
@@ -129,6 +134,10 @@ impl Simulation {
         for (w, e) in self.wheelsets.iter_mut().zip(vehicles) {
             match &mut w.vehicle {
                 VehicleState::RollPlane(r) => r.set_state_vector(e)?,
+                VehicleState::AxleBox { body, box_force } => {
+                    body.set_state_vector(&e[..5])?;
+                    *box_force = [e[5], e[6]];
+                }
                 VehicleState::External {
                     wheel_z,
                     rotation,

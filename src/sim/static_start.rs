@@ -17,7 +17,7 @@ use crate::wheel::WheelProfile;
 /// Errors: a constant or static load below 0 N.
 pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
-        VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::RollPlane(p) | VehicleSpec::AxleBox(p) => [p.static_wheel_load(); 2],
         VehicleSpec::LumpedWheels(p) => [p.load; 2],
         VehicleSpec::ConstantLoad(p) => {
             non_negative("load.left", p[0], "N")?;
@@ -101,6 +101,10 @@ impl Simulation {
             let zw = [zr[0] - delta[0], zr[1] - delta[1]];
             match &mut self.wheelsets.get_mut(k).expect("k < len").vehicle {
                 VehicleState::RollPlane(v) => v.set_static(zw)?,
+                VehicleState::AxleBox { body, box_force } => {
+                    body.set_static(zw);
+                    *box_force = body.static_box_force(p);
+                }
                 VehicleState::LumpedWheels(v) => v.set_static(zw),
                 VehicleState::ConstantLoad(_) => {}
                 VehicleState::External { wheel_z, .. } => *wheel_z = zw,

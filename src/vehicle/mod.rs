@@ -8,12 +8,17 @@
 //!   the wheel load `W`.
 //! * [`LumpedTrack`]: the chapter-2 lumped track mass (2.27, second equation), one per rail.
 //!
+//! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
+//!   (the primary suspension), for a bogie model that couples at its own step.
+//!
 //! Roll angles are positive when they raise the right side (docs/MODEL.md).
 
+mod axle_box;
 mod lumped;
 mod roll_plane;
 #[cfg(test)]
 mod tests;
 
+pub use axle_box::{SprungBogie, WheelsetBody};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
