@@ -30,7 +30,7 @@ impl Simulation {
         for (k, w) in self.wheelsets.iter().enumerate() {
             let beyond = match &w.vehicle {
                 VehicleState::RollPlane(v) => v.beyond_bounds(),
-                VehicleState::AxleBox { body, .. } => body.beyond_bounds(),
+                VehicleState::AxleBox(link) => link.body().beyond_bounds(),
                 _ => None,
             };
             if let Some((what, value, limit)) = beyond {

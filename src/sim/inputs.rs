@@ -99,22 +99,27 @@ impl Simulation {
         Ok(())
     }
 
-    /// Sets the axle-box (primary suspension) forces `[left, right]` (N, pressing the
-    /// wheelset down) of wheelset `k` (0 the leading one) of a simulation with
-    /// [`VehicleSpec::AxleBox`](super::VehicleSpec::AxleBox) wheelsets, held from now
-    /// until they are set again. Refused for any other vehicle, a wheelset the
-    /// simulation does not have, and a force not finite or beyond the force limit.
-    pub fn set_axle_box_forces_of(&mut self, k: usize, f: [f64; 2]) -> Result<()> {
-        let lim = self.force_limit;
-        for (name, x) in [
-            ("axle_box.left.force", f[0]),
-            ("axle_box.right.force", f[1]),
-        ] {
+    /// Sets the side frames' displacements `z` and velocities `v` `[left, right]` (m,
+    /// m/s) above the axle boxes of wheelset `k` (0 the leading one) of a simulation
+    /// with [`VehicleSpec::AxleBox`](super::VehicleSpec::AxleBox) wheelsets, at the
+    /// current time; from now on the side frames move on at `v` until set again
+    /// ([`crate::vehicle::PrimaryLink::set_side_frames`]). Refused for any other
+    /// vehicle, a wheelset the simulation does not have, and values not finite or
+    /// beyond [`crate::limits::BODY_DISPLACEMENT_LIMIT`] (m) or 100 m/s.
+    pub fn set_side_frames_of(&mut self, k: usize, z: [f64; 2], v: [f64; 2]) -> Result<()> {
+        use crate::limits::BODY_DISPLACEMENT_LIMIT;
+        let named = [
+            ("side_frame.left.z", z[0], BODY_DISPLACEMENT_LIMIT, "m"),
+            ("side_frame.right.z", z[1], BODY_DISPLACEMENT_LIMIT, "m"),
+            ("side_frame.left.v", v[0], 100.0, "m/s"),
+            ("side_frame.right.v", v[1], 100.0, "m/s"),
+        ];
+        for (name, x, lim, unit) in named {
             if !within(x, lim) {
                 return Err(out_of_range(
                     name,
                     x,
-                    format!("-{lim} N <= {name} <= {lim} N (the force limit)"),
+                    format!("-{lim} {unit} <= {name} <= {lim} {unit}"),
                 ));
             }
         }
@@ -127,24 +132,29 @@ impl Simulation {
             )
         })?;
         match &mut w.vehicle {
-            VehicleState::AxleBox { box_force, .. } => {
-                *box_force = f;
-                self.clear_cache();
+            VehicleState::AxleBox(link) => {
+                link.set_side_frames(z, v);
                 Ok(())
             }
             _ => Err(Error::Unsupported(
-                "axle-box forces for a simulation whose wheelsets are not cut at the axle boxes"
+                "side-frame inputs for a simulation whose wheelsets are not cut at the axle \
+                 boxes"
                     .into(),
             )),
         }
     }
 
-    /// The axle boxes of wheelset `k` at `t_j`: displacements and velocities `[left,
-    /// right]` (m, m/s, velocities backward differences over the last step); `None` for
-    /// a wheelset the simulation does not have or not cut at its axle boxes.
-    pub fn axle_box_motion_of(&self, k: usize) -> Option<([f64; 2], [f64; 2])> {
+    /// The primary suspension of wheelset `k`: its forces `[left, right]` (N, pressing
+    /// the wheelset down) averaged over the steps since the side frames were last set
+    /// (the impulse the bogie takes over its communication step), and the axle boxes'
+    /// displacements and velocities at `t_j` (m, m/s); `None` for a wheelset the
+    /// simulation does not have or not cut at its axle boxes.
+    pub fn primary_of(&self, k: usize) -> Option<([f64; 2], [f64; 2], [f64; 2])> {
         match &self.wheelsets.get(k)?.vehicle {
-            VehicleState::AxleBox { body, .. } => Some((body.wheel_z(), body.box_velocity())),
+            VehicleState::AxleBox(link) => {
+                let b = link.body();
+                Some((link.mean_force(), b.wheel_z(), b.box_velocity()))
+            }
             _ => None,
         }
     }

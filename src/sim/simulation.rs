@@ -42,14 +42,10 @@ pub enum VehicleState {
     LumpedWheels(LumpedWheels),
     /// Constant loads (N), no contact.
     ConstantLoad([f64; 2]),
-    /// The wheelset of the roll-plane vehicle, its bogie outside: the axle-box forces
-    /// `[left, right]` (N, pressing the wheelset down) are inputs held over each step.
-    AxleBox {
-        /// The wheelset.
-        body: crate::vehicle::WheelsetBody,
-        /// Axle-box forces `[left, right]` (N).
-        box_force: [f64; 2],
-    },
+    /// The wheelset of the roll-plane vehicle with its primary suspension, the bogie
+    /// above it outside ([`crate::vehicle::PrimaryLink`]): the side frames' motion is
+    /// the input, the primary forces the output.
+    AxleBox(crate::vehicle::PrimaryLink),
     /// Wheels moved from outside.
     External {
         /// Wheel-centre displacements `[left, right]` (m), inputs.
@@ -72,7 +68,7 @@ impl VehicleState {
             VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
             VehicleState::ConstantLoad(_) => None,
             VehicleState::External { wheel_z, .. } => Some(*wheel_z),
-            VehicleState::AxleBox { body, .. } => Some(body.wheel_z()),
+            VehicleState::AxleBox(link) => Some(link.body().wheel_z()),
         }
     }
 
@@ -82,7 +78,7 @@ impl VehicleState {
         match self {
             VehicleState::RollPlane(v) => v.step(p),
             VehicleState::LumpedWheels(v) => v.step(p),
-            VehicleState::AxleBox { body, box_force } => body.step(p, *box_force),
+            VehicleState::AxleBox(link) => link.step(p),
             VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
         }
     }
@@ -392,10 +388,9 @@ impl Simulation {
                     VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
                 }
                 VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
-                VehicleSpec::AxleBox(p) => VehicleState::AxleBox {
-                    body: crate::vehicle::WheelsetBody::new(p, dt)?,
-                    box_force: [0.0; 2],
-                },
+                VehicleSpec::AxleBox(p) => {
+                    VehicleState::AxleBox(crate::vehicle::PrimaryLink::new(p, dt)?)
+                }
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
@@ -1037,7 +1032,7 @@ impl Simulation {
         for w in self.wheelsets.iter_mut() {
             match &mut w.vehicle {
                 VehicleState::RollPlane(v) => v.change_dt(dt)?,
-                VehicleState::AxleBox { body, .. } => body.change_dt(dt)?,
+                VehicleState::AxleBox(link) => link.change_dt(dt)?,
                 VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
                 VehicleState::LumpedWheels(_) => {
                     return Err(Error::Unsupported(

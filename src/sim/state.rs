@@ -57,11 +57,7 @@ impl Simulation {
                 rotation,
                 since,
             } => vec![wheel_z[0], wheel_z[1], *rotation, *since],
-            VehicleState::AxleBox { body, box_force } => {
-                let mut v = body.state_vector();
-                v.extend(box_force);
-                v
-            }
+            VehicleState::AxleBox(link) => link.state_vector(),
             VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
         })
     }
@@ -134,10 +130,7 @@ impl Simulation {
         for (w, e) in self.wheelsets.iter_mut().zip(vehicles) {
             match &mut w.vehicle {
                 VehicleState::RollPlane(r) => r.set_state_vector(e)?,
-                VehicleState::AxleBox { body, box_force } => {
-                    body.set_state_vector(&e[..5])?;
-                    *box_force = [e[5], e[6]];
-                }
+                VehicleState::AxleBox(link) => link.set_state_vector(e)?,
                 VehicleState::External {
                     wheel_z,
                     rotation,

@@ -101,10 +101,7 @@ impl Simulation {
             let zw = [zr[0] - delta[0], zr[1] - delta[1]];
             match &mut self.wheelsets.get_mut(k).expect("k < len").vehicle {
                 VehicleState::RollPlane(v) => v.set_static(zw)?,
-                VehicleState::AxleBox { body, box_force } => {
-                    body.set_static(zw);
-                    *box_force = body.static_box_force(p);
-                }
+                VehicleState::AxleBox(link) => link.set_static(zw, p),
                 VehicleState::LumpedWheels(v) => v.set_static(zw),
                 VehicleState::ConstantLoad(_) => {}
                 VehicleState::External { wheel_z, .. } => *wheel_z = zw,

@@ -19,6 +19,6 @@ mod roll_plane;
 #[cfg(test)]
 mod tests;
 
-pub use axle_box::{SprungBogie, WheelsetBody};
+pub use axle_box::{BogieDrive, PrimaryLink, SprungBogie, WheelsetBody};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
