@@ -8,17 +8,23 @@
 //!   the wheel load `W`.
 //! * [`LumpedTrack`]: the chapter-2 lumped track mass (2.27, second equation), one per rail.
 //!
+//! * [`HalfCarParams`]: the thesis' half-car bogie (figure 1.10), ten degrees of
+//!   freedom, its matrices, natural frequencies and static state.
 //! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
 //!   (the primary suspension), for a bogie model that couples at its own step.
 //!
 //! Roll angles are positive when they raise the right side (docs/MODEL.md).
 
 mod axle_box;
+mod half_car;
 mod lumped;
 mod roll_plane;
 #[cfg(test)]
 mod tests;
 
 pub use axle_box::{BogieDrive, PrimaryLink, SprungBogie, WheelsetBody};
+pub use half_car::{
+    HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
+};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};

@@ -123,3 +123,98 @@ fn bad_vehicle_parameters_are_refused() {
     let e = RollPlaneVehicle::new(p, 1e-5).unwrap_err().to_string();
     assert!(e.contains("vehicle.primary.damping"), "{e}");
 }
+
+/// The half-car bogie of table 4.4 with a freight bogie's 1.8 m wheelbase and a side
+/// frame's pitch inertia of 90 kg m^2 (about a 450 kg, 1.5 m side frame).
+fn half_car() -> HalfCarParams {
+    HalfCarParams::from_roll_plane(&table_4_4(), 1.8, 90.0)
+}
+
+#[test]
+fn half_car_natural_frequencies_are_the_eigenvalues_of_m_inv_k() {
+    // The symmetric route (M^-1/2 K M^-1/2) against the general eigenvalues of M^-1 K.
+    let p = half_car();
+    p.validate().unwrap();
+    let minv = HalfCarMatrix::from_diagonal(&p.mass_diagonal().map(|m| 1.0 / m));
+    let general = (minv * p.stiffness_matrix()).complex_eigenvalues();
+    let mut lambda: Vec<f64> = general.iter().map(|c| c.re).collect();
+    lambda.sort_by(f64::total_cmp);
+    let top = lambda[HALF_CAR_DOFS - 1];
+    for (w, l) in p.natural_frequencies().iter().zip(&lambda) {
+        assert!((w * w - l).abs() <= 1e-9 * top, "{w} {l}");
+    }
+    for c in general.iter() {
+        assert!(c.im.abs() < 1e-9 * top, "{c}");
+    }
+    // Without the rails under the wheels the bogie moves freely as a whole: bounce,
+    // roll, pitch and warp (the side frames pitching against each other, the wheelsets
+    // rolling against each other) are rigid; the other six modes are elastic.
+    let w = p.natural_frequencies();
+    let rigid = w
+        .iter()
+        .filter(|&&x| x < 1e-3 * w[HALF_CAR_DOFS - 1])
+        .count();
+    assert_eq!(rigid, 4, "{w:?}");
+}
+
+#[test]
+fn half_car_static_loads_share_the_weight_equally_and_balance_it() {
+    let p = half_car();
+    let d = p.static_state([[0.0; 2]; 2]).unwrap();
+    let f = p.static_contact_forces(&d);
+    let w = p.static_wheel_load();
+    // Twice the roll-plane vehicle's wheel load: the same 107.66 kN per wheel.
+    assert!((w / table_4_4().static_wheel_load() - 1.0).abs() < 1e-12);
+    for x in f.iter().flatten() {
+        assert!((x / w - 1.0).abs() < 1e-9, "{x} {w}");
+    }
+    // Unequal wheel heights: the forces change, their sum is the weight.
+    let d = p
+        .static_state([[-1e-3, -1.2e-3], [-1.1e-3, -0.9e-3]])
+        .unwrap();
+    let f = p.static_contact_forces(&d);
+    let sum: f64 = f.iter().flatten().sum();
+    assert!((sum / (4.0 * w) - 1.0).abs() < 1e-9, "{sum}");
+    // And the state is an equilibrium: K d = F_gravity + F_contact.
+    let r = p.stiffness_matrix() * d - p.gravity_force() - p.contact_force(f);
+    assert!(r.norm() < 1e-6 * w, "{r}");
+}
+
+#[test]
+fn half_car_with_its_wheelsets_moving_alike_is_the_roll_plane_vehicle() {
+    // Cut fore and aft, the in-phase half of the half-car bogie is twice the
+    // roll-plane vehicle: its six natural frequencies are among the half-car's ten,
+    // whatever the wheelbase and the side frames' pitch inertia (those set the other
+    // four, the pitch and out-of-phase modes).
+    let rp = table_4_4();
+    // The thesis' roll-plane vehicle carries the car body as a weight on the bolster,
+    // not as its mass (3.1-3.3); the half-car bogie carries the car body's share as
+    // the bolster's mass. Compared like with like: the roll-plane vehicle with the car
+    // body's mass on its bolster (the same weight).
+    let mut massive = rp;
+    massive.bolster_mass += massive.carbody_mass;
+    massive.carbody_mass = 0.0;
+    let six = massive.natural_frequencies();
+    // Its four elastic modes (bounce and roll of the whole are rigid without the
+    // rails).
+    let elastic: Vec<f64> = six.iter().copied().filter(|&w| w > 1e-3 * six[5]).collect();
+    assert_eq!(elastic.len(), 4, "{six:?}");
+    for (a, j) in [(1.8, 90.0), (2.5, 40.0), (1.5, 300.0)] {
+        let ten = HalfCarParams::from_roll_plane(&rp, a, j).natural_frequencies();
+        for &w in &elastic {
+            let nearest = ten.iter().map(|x| (x - w).abs()).fold(f64::MAX, f64::min);
+            assert!(nearest <= 1e-9 * w, "wheelbase {a}: {w} not among {ten:?}");
+        }
+    }
+    // A static state with both wheelsets alike equals the roll-plane vehicle's.
+    let p = half_car();
+    let z = [-1.0e-3, -1.3e-3];
+    let d = p.static_state([z, z]).unwrap();
+    let mut v = RollPlaneVehicle::new(rp, 45e-6).unwrap();
+    v.set_static(z).unwrap();
+    let r = v.displacements();
+    for (a, b) in [(d[0], r[0]), (d[1], r[1]), (d[2], r[2]), (d[4], r[3])] {
+        assert!((a - b).abs() <= 1e-12 + 1e-9 * b.abs(), "{a} {b}");
+    }
+    assert!(d[3].abs() < 1e-15 && d[5].abs() < 1e-15);
+}
