@@ -32,12 +32,12 @@ pub enum VehicleSpec {
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).
     ConstantLoad([f64; 2]),
-    /// The roll-plane vehicle's wheelsets on the track, cut at their axle boxes
-    /// ([`crate::vehicle::WheelsetBody`]): the bogie above them is a co-simulation
-    /// partner that sets each wheelset's primary (axle-box) forces
-    /// ([`crate::sim::Simulation::set_axle_box_forces_of`]) and reads the axle boxes'
-    /// motion ([`crate::sim::Simulation::axle_box_motion_of`]). The static loads are the
-    /// whole vehicle's.
+    /// The roll-plane vehicle's wheelsets on the track with their primary suspensions,
+    /// cut above them ([`crate::vehicle::PrimaryLink`]): the bogie above is a
+    /// co-simulation partner that sets each wheelset's side frames' motion
+    /// ([`crate::sim::Simulation::set_side_frames_of`]) and reads the mean primary
+    /// forces ([`crate::sim::Simulation::primary_of`]). The static loads are the whole
+    /// vehicle's.
     AxleBox(RollPlaneParams),
     /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
     /// displacements and the axle angle are inputs
