@@ -214,6 +214,18 @@ fn wheelset_vrs(rust: &mut String, table: &Table) {
         })
     )
     .unwrap();
+    writeln!(
+        rust,
+        "/// `wheelset[k].sideframe.left.z`, `.right.z`, `.left.v`, `.right.v`, k = 2, 3, ..\n\
+         pub const TRAILING_FRAME_VRS: [[u32; 4]; {n}] = [{}];",
+        list(&|k| format!(
+            "[{}]",
+            ["left.z", "right.z", "left.v", "right.v"]
+                .map(|q| vr_of(table, &format!("wheelset[{k}].sideframe.{q}")).to_string())
+                .join(", ")
+        )),
+    )
+    .unwrap();
     let sites: Vec<String> = (1..)
         .map_while(|j| table.names.get(&format!("site[{j}].position")))
         .map(|r| r.to_string())

@@ -32,7 +32,10 @@ fn main() {
     );
     println!("|---|---|---|---|");
     let mut cut = mono.clone();
-    cut.vehicle = VehicleSpec::AxleBox(p);
+    cut.vehicle = VehicleSpec::AxleBox {
+        vehicle: p,
+        static_load: [p.static_wheel_load(); 2],
+    };
     for h in [0.0, 1e-4, 5e-4, 1e-3, 1.44e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3] {
         let mut sim = Simulation::new(&cut).unwrap();
         let dt = sim.dt();

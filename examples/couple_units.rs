@@ -32,6 +32,7 @@ fn main() -> Result<(), wheelflat::Error> {
         wheel_radius: scenario.wheel_radius,
         dt: 0.0,
         static_wheel_z: track.wheel_z(),
+        axle_box: false,
     })?;
     let h = per_exchange as f64 * track.dt();
     let revolution = std::f64::consts::TAU * scenario.wheel_radius / scenario.speed;

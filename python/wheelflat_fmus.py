@@ -239,5 +239,48 @@ def run_bogie(paths, stop_time, wheelsets=2, track_params=None, vehicle_params=N
             v.close()
 
 
+FRAMES = ("sideframe.left.z", "sideframe.right.z", "sideframe.left.v", "sideframe.right.v")
+PRIMARY = ("primary.left.force", "primary.right.force")
+AXLE_BOX = ("axle_box.left.force", "axle_box.right.force")
+
+
+def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None):
+    """Couples TrackContact and RollPlaneVehicle at the axle boxes (``interface`` =
+    axle_box): TrackContact carries the wheelset and its primary suspension,
+    RollPlaneVehicle the bodies above. Per communication step: the side frames' motion
+    (``sideframe.*.z``, ``.v``) to the track, the track steps, its mean primary forces
+    over that step (``primary.*.force``) to the vehicle (``axle_box.*.force``), the
+    vehicle steps (track first: a Gauss-Seidel exchange). Returns the track's largest
+    contact forces ``[left, right]`` (N) over the run."""
+    tp = dict(track_params or {}, interface=2)
+    vp = dict(vehicle_params or {}, interface=2)
+    track = Unit(paths["TrackContact"], "track")
+    vehicle = Unit(paths["RollPlaneVehicle"], "vehicle")
+    try:
+        for u in (track, vehicle):
+            u.fmu.setupExperiment(startTime=0.0)
+        track.set_parameters(tp)
+        vehicle.set_parameters(vp)
+        vehicle.fmu.enterInitializationMode()
+        track.fmu.enterInitializationMode()
+        loads = ("static_load.left", "static_load.right")
+        track.set(loads, vehicle.get(*loads))
+        heights = ("static_wheel_z.left", "static_wheel_z.right")
+        vehicle.set(heights, track.get(*heights))
+        vehicle.fmu.exitInitializationMode()
+        track.fmu.exitInitializationMode()
+        n = int(round(stop_time / comm_step))
+        for k in range(n):
+            t = k * comm_step
+            track.set(FRAMES, vehicle.get(*FRAMES))
+            track.fmu.doStep(t, comm_step)
+            vehicle.set(AXLE_BOX, track.get(*PRIMARY))
+            vehicle.fmu.doStep(t, comm_step)
+        return track.get("contact.left.max_force", "contact.right.max_force")
+    finally:
+        track.close()
+        vehicle.close()
+
+
 if __name__ == "__main__":
     install_venv()

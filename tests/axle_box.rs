@@ -24,7 +24,10 @@ fn cut(h: f64, duration: f64, dt_bogie: f64) -> Vec<f64> {
     let mono = Scenario::table_4_4_flat();
     let p = params(&mono);
     let mut s = mono.clone();
-    s.vehicle = VehicleSpec::AxleBox(p);
+    s.vehicle = VehicleSpec::AxleBox {
+        vehicle: p,
+        static_load: [p.static_wheel_load(); 2],
+    };
     let mut sim = Simulation::new(&s).unwrap();
     let dt = sim.dt();
     let per = (h / dt).round().max(1.0) as u64;
@@ -68,7 +71,10 @@ fn the_cut_model_starts_in_the_monolithic_static_equilibrium() {
     let p = params(&mono);
     let whole = Simulation::new(&mono).unwrap();
     let mut s = mono.clone();
-    s.vehicle = VehicleSpec::AxleBox(p);
+    s.vehicle = VehicleSpec::AxleBox {
+        vehicle: p,
+        static_load: [p.static_wheel_load(); 2],
+    };
     let sim = Simulation::new(&s).unwrap();
     let (f_track, z, v) = sim.primary_of(0).unwrap();
     assert_eq!(z, whole.wheel_z());

@@ -144,6 +144,17 @@ impl Simulation {
         }
     }
 
+    /// The side frames' displacements and velocities `[left, right]` (m, m/s) last set
+    /// for wheelset `k` (at the static start, where the primary springs carry the
+    /// static loads); `None` for a wheelset the simulation does not have or not cut at
+    /// its axle boxes.
+    pub fn side_frames_of(&self, k: usize) -> Option<([f64; 2], [f64; 2])> {
+        match &self.wheelsets.get(k)?.vehicle {
+            VehicleState::AxleBox(link) => Some(link.side_frames()),
+            _ => None,
+        }
+    }
+
     /// The primary suspension of wheelset `k`: its forces `[left, right]` (N, pressing
     /// the wheelset down) averaged over the steps since the side frames were last set
     /// (the impulse the bogie takes over its communication step), and the axle boxes'

@@ -36,9 +36,16 @@ pub enum VehicleSpec {
     /// cut above them ([`crate::vehicle::PrimaryLink`]): the bogie above is a
     /// co-simulation partner that sets each wheelset's side frames' motion
     /// ([`crate::sim::Simulation::set_side_frames_of`]) and reads the mean primary
-    /// forces ([`crate::sim::Simulation::primary_of`]). The static loads are the whole
-    /// vehicle's.
-    AxleBox(RollPlaneParams),
+    /// forces ([`crate::sim::Simulation::primary_of`]). Of the vehicle's parameters
+    /// only the wheelset's (mass, roll inertia), the primary suspension's (stiffness,
+    /// damping, spacing) and gravity are used.
+    AxleBox {
+        /// The vehicle, for its wheelset and primary suspension.
+        vehicle: RollPlaneParams,
+        /// Static wheel loads `[left, right]` (N): the whole vehicle's
+        /// ([`RollPlaneParams::static_wheel_load`]) or the bogie model's.
+        static_load: [f64; 2],
+    },
     /// Wheels moved from outside (co-simulation with an external vehicle): the wheel
     /// displacements and the axle angle are inputs
     /// ([`crate::sim::Simulation::set_wheel_inputs`]); `static_load` `[left, right]`

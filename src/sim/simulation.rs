@@ -388,8 +388,8 @@ impl Simulation {
                     VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
                 }
                 VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
-                VehicleSpec::AxleBox(p) => {
-                    VehicleState::AxleBox(crate::vehicle::PrimaryLink::new(p, dt)?)
+                VehicleSpec::AxleBox { vehicle, .. } => {
+                    VehicleState::AxleBox(crate::vehicle::PrimaryLink::new(vehicle, dt)?)
                 }
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],

@@ -17,7 +17,12 @@ use crate::wheel::WheelProfile;
 /// Errors: a constant or static load below 0 N.
 pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
-        VehicleSpec::RollPlane(p) | VehicleSpec::AxleBox(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::AxleBox { static_load, .. } => {
+            non_negative("static_load.left", static_load[0], "N")?;
+            non_negative("static_load.right", static_load[1], "N")?;
+            *static_load
+        }
         VehicleSpec::LumpedWheels(p) => [p.load; 2],
         VehicleSpec::ConstantLoad(p) => {
             non_negative("load.left", p[0], "N")?;

@@ -23,6 +23,7 @@ fn run_pair(s: &Scenario, h_per_dt: u64, steps: usize) -> Vec<[f64; 2]> {
         speed: s.speed,
         wheel_radius: s.wheel_radius,
         dt: 0.0,
+        axle_box: false,
         static_wheel_z: track.wheel_z(),
     })
     .unwrap();
@@ -79,6 +80,7 @@ fn table_4_4_unit(
         wheel_radius: 0.475,
         dt: dt(&vp),
         static_wheel_z,
+        axle_box: false,
     }
 }
 

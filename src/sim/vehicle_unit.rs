@@ -13,7 +13,7 @@ use crate::error::{Error, Result, finite, non_negative, num, out_of_range, posit
 use crate::limits::{
     MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
 };
-use crate::vehicle::{RollPlaneParams, RollPlaneVehicle};
+use crate::vehicle::{RollPlaneParams, RollPlaneVehicle, SprungBogie};
 use nalgebra::Vector6;
 
 /// Parameters of a [`VehicleUnit`].
@@ -30,6 +30,13 @@ pub struct VehicleUnitParams {
     /// Wheel-centre displacements `[left, right]` (m) of the static equilibrium, as the
     /// track computed them: the vehicle starts at rest on them.
     pub static_wheel_z: [f64; 2],
+    /// The axle-box interface: the unit is the vehicle above its primary suspension
+    /// ([`crate::vehicle::SprungBogie::force_driven`]), the primary forces come in
+    /// (held over each communication step) and the side frames' motion goes out; its
+    /// partner carries the wheelset and the primary suspension
+    /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
+    /// contact forces in.
+    pub axle_box: bool,
 }
 
 /// The six-DOF roll-plane vehicle (3.1-3.3, 3.24-3.27) as a co-simulation unit: the
@@ -41,6 +48,9 @@ pub struct VehicleUnitParams {
 pub struct VehicleUnit {
     params: VehicleUnitParams,
     vehicle: RollPlaneVehicle,
+    /// With the axle-box interface: the bodies above the primary suspension, which step
+    /// instead of `vehicle` (then at rest on the static wheel heights).
+    sprung: Option<SprungBogie>,
     /// Equal substeps of at most the base step; steps shorter than
     /// [`MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
     /// vehicle's.
@@ -91,13 +101,25 @@ impl VehicleUnit {
         }
         let mut vehicle = RollPlaneVehicle::new(p.vehicle, dt)?;
         vehicle.set_static(p.static_wheel_z)?;
-        let w = p.vehicle.static_wheel_load();
+        let sprung = if p.axle_box {
+            let mut b = SprungBogie::force_driven(p.vehicle, dt)?;
+            b.set_static(p.static_wheel_z)?;
+            Some(b)
+        } else {
+            None
+        };
+        // The held inputs start static: the contact forces, or the primary forces.
+        let w = match &sprung {
+            Some(_) => vehicle.bearing_forces(),
+            None => [p.vehicle.static_wheel_load(); 2],
+        };
         let unit = VehicleUnit {
             params: *p,
             vehicle,
+            sprung,
             clock: Clock::new(dt, Stepping::Substeps),
-            force: [w, w],
-            extremes: ForceExtremes::at([w, w]),
+            force: w,
+            extremes: ForceExtremes::at(w),
         };
         unit.check_states()?;
         Ok(unit)
@@ -132,15 +154,40 @@ impl VehicleUnit {
     pub fn wheel_z(&self) -> [f64; 2] {
         self.vehicle.wheel_z()
     }
-    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad).
-    pub fn displacements(&self) -> &Vector6<f64> {
-        self.vehicle.displacements()
+    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad); with the
+    /// axle-box interface the wheelset's are its static ones (the partner carries it).
+    pub fn displacements(&self) -> Vector6<f64> {
+        let mut d = *self.vehicle.displacements();
+        if let Some(b) = &self.sprung {
+            d.fixed_rows_mut::<4>(0).copy_from(b.displacements());
+        }
+        d
     }
-    /// Primary suspension (bearing) forces `[left, right]` (N), pressing the wheelset down.
+    /// Primary suspension (bearing) forces `[left, right]` (N), pressing the wheelset
+    /// down; with the axle-box interface the held inputs.
     pub fn bearing_forces(&self) -> [f64; 2] {
-        self.vehicle.bearing_forces()
+        match &self.sprung {
+            Some(_) => self.force,
+            None => self.vehicle.bearing_forces(),
+        }
     }
-    /// The held contact forces `[left, right]` (N).
+    /// The side frames' displacements and velocities `[left, right]` (m, m/s) at the
+    /// current time, the velocities backward differences over the last step.
+    pub fn side_frames(&self) -> ([f64; 2], [f64; 2]) {
+        match &self.sprung {
+            Some(b) => b.side_frames(),
+            None => {
+                let (d, v) = (self.vehicle.displacements(), self.vehicle.velocities());
+                ([d[2], d[3]], [v[2], v[3]])
+            }
+        }
+    }
+    /// Whether the unit is the vehicle above its primary suspension.
+    pub fn is_axle_box(&self) -> bool {
+        self.sprung.is_some()
+    }
+    /// The held contact forces `[left, right]` (N); with the axle-box interface the
+    /// held primary forces.
     pub fn forces(&self) -> [f64; 2] {
         self.force
     }
@@ -162,7 +209,11 @@ impl VehicleUnit {
     /// nothing is set then.
     pub fn set_forces(&mut self, p: [f64; 2]) -> Result<()> {
         let lim = crate::limits::force_limit(self.static_load());
-        for (name, x) in [("contact.left.force", p[0]), ("contact.right.force", p[1])] {
+        let names = match &self.sprung {
+            Some(_) => ["axle_box.left.force", "axle_box.right.force"],
+            None => ["contact.left.force", "contact.right.force"],
+        };
+        for (name, x) in [(names[0], p[0]), (names[1], p[1])] {
             finite(name, x, "N")?;
             if !crate::limits::within(x, lim) {
                 return Err(crate::error::out_of_range(
@@ -212,13 +263,26 @@ impl VehicleUnit {
         }
         self.clock.carried = 0.0;
         if let Some(dt) = s.dt {
-            self.vehicle.change_dt(dt)?;
+            match &mut self.sprung {
+                Some(b) => b.change_dt(dt)?,
+                None => self.vehicle.change_dt(dt)?,
+            }
             self.clock.restart(dt);
         }
         self.extremes.record(self.force);
-        for _ in 0..s.n as u64 {
-            self.vehicle.step(self.force);
-            self.clock.tick();
+        match &mut self.sprung {
+            Some(b) => {
+                for _ in 0..s.n as u64 {
+                    b.step_forced(self.force);
+                    self.clock.tick();
+                }
+            }
+            None => {
+                for _ in 0..s.n as u64 {
+                    self.vehicle.step(self.force);
+                    self.clock.tick();
+                }
+            }
         }
         self.check_states()
     }
@@ -259,7 +323,10 @@ impl VehicleUnit {
 
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
-        let bad = self.vehicle.beyond_bounds();
+        let bad = match &self.sprung {
+            Some(b) => b.beyond_bounds(),
+            None => self.vehicle.beyond_bounds(),
+        };
         match bad {
             None => Ok(()),
             Some((what, value, limit)) => Err(Error::Diverged {
@@ -286,7 +353,10 @@ impl VehicleUnit {
         let c = &self.clock;
         let mut v = vec![c.t0, c.k as f64, c.carried, self.force[0], self.force[1]];
         v.extend(self.extremes.to_array());
-        v.extend(self.vehicle.state_vector());
+        match &self.sprung {
+            Some(b) => v.extend(b.state_vector()),
+            None => v.extend(self.vehicle.state_vector()),
+        }
         v
     }
 
@@ -297,7 +367,11 @@ impl VehicleUnit {
     /// [`MIN_STEP_FRACTION`]` dt_base ..= dt_base`, and a state beyond the health bounds
     /// ([`VehicleUnit::check_states`]).
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let len = HEAD + self.vehicle.state_vector().len();
+        let body_len = match &self.sprung {
+            Some(b) => b.state_vector().len(),
+            None => self.vehicle.state_vector().len(),
+        };
+        let len = HEAD + body_len;
         if v.len() != len {
             return Err(out_of_range(
                 "vehicle unit state length",
@@ -328,8 +402,16 @@ impl VehicleUnit {
                 format!("{} s <= dt <= {} s", num(min_step), num(self.clock.base)),
             ));
         }
-        self.vehicle.set_state_vector(&v[HEAD..])?;
-        self.clock.dt = self.vehicle.dt();
+        match &mut self.sprung {
+            Some(b) => {
+                b.set_state_vector(&v[HEAD..])?;
+                self.clock.dt = b.dt();
+            }
+            None => {
+                self.vehicle.set_state_vector(&v[HEAD..])?;
+                self.clock.dt = self.vehicle.dt();
+            }
+        }
         self.clock.t0 = v[0];
         self.clock.k = v[1] as u64;
         self.clock.carried = v[2];

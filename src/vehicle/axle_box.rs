@@ -44,9 +44,17 @@ impl WheelsetBody {
     /// The wheelset of `p` (its mass, roll inertia, primary spacing and gravity), at
     /// rest at zero, stepped with `dt` (s).
     ///
-    /// Errors: a parameter [`RollPlaneParams::validate`] refuses; `dt` not positive.
+    /// Errors: the wheelset's mass or roll inertia, the primary spacing or gravity
+    /// outside its physical range ([`crate::limits::check`]); `dt` not positive.
     pub fn new(p: &RollPlaneParams, dt: f64) -> Result<WheelsetBody> {
-        p.validate()?;
+        for (name, x) in [
+            ("vehicle.wheelset.mass", p.wheelset_mass),
+            ("vehicle.wheelset.inertia", p.wheelset_inertia),
+            ("vehicle.primary.spacing", p.primary_spacing),
+            ("gravity", p.gravity),
+        ] {
+            crate::limits::check(name, x)?;
+        }
         positive("solver.dt", dt, "s")?;
         Ok(WheelsetBody {
             mass: p.wheelset_mass,
@@ -190,8 +198,11 @@ pub struct PrimaryLink {
 impl PrimaryLink {
     /// The wheelset and primary suspension of `p`, stepped with `dt` (s).
     ///
-    /// Errors: as [`WheelsetBody::new`].
+    /// Errors: as [`WheelsetBody::new`], and the primary stiffness or damping outside
+    /// its physical range.
     pub fn new(p: &RollPlaneParams, dt: f64) -> Result<PrimaryLink> {
+        crate::limits::check("vehicle.primary.stiffness", p.primary_stiffness)?;
+        crate::limits::check("vehicle.primary.damping", p.primary_damping)?;
         Ok(PrimaryLink {
             body: WheelsetBody::new(p, dt)?,
             stiffness: p.primary_stiffness,
@@ -220,6 +231,11 @@ impl PrimaryLink {
         self.force = f;
         self.force_sum = [0.0; 2];
         self.steps = 0;
+    }
+
+    /// The side frames' displacements and velocities `[left, right]` (m, m/s) last set.
+    pub fn side_frames(&self) -> ([f64; 2], [f64; 2]) {
+        (self.frame_z, self.frame_v)
     }
 
     /// Takes the side frames' displacements `z` (m) and velocities `v` (m/s) at the
@@ -411,6 +427,55 @@ impl SprungBogie {
     /// Step (s).
     pub fn dt(&self) -> f64 {
         self.dt
+    }
+
+    /// Changes the step to `dt` (s), keeping the displacements and the
+    /// backward-difference velocities, as [`super::RollPlaneVehicle::change_dt`].
+    ///
+    /// Errors: `dt` not positive or above the whole vehicle's critical step.
+    pub fn change_dt(&mut self, dt: f64) -> Result<()> {
+        positive("solver.dt", dt, "s")?;
+        self.params.check_time_step(dt)?;
+        let ratio = dt / self.dt;
+        self.d_prev = self.d - (self.d - self.d_prev) * ratio;
+        self.set_coefficients(dt);
+        Ok(())
+    }
+
+    /// `[dt, d (4), d_prev (4)]`.
+    pub fn state_vector(&self) -> Vec<f64> {
+        let mut v = vec![self.dt];
+        v.extend(self.d.iter());
+        v.extend(self.d_prev.iter());
+        v
+    }
+
+    /// Restores [`SprungBogie::state_vector`].
+    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        if v.len() != 9 {
+            return Err(out_of_range(
+                "bogie state length",
+                v.len() as f64,
+                "9 values",
+            ));
+        }
+        if v[0] != self.dt {
+            self.change_dt(v[0])?;
+        }
+        self.d = Vector4::from_column_slice(&v[1..5]);
+        self.d_prev = Vector4::from_column_slice(&v[5..9]);
+        Ok(())
+    }
+
+    /// A displacement beyond [`BODY_DISPLACEMENT_LIMIT`], named as the roll-plane
+    /// vehicle's.
+    pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
+        self.d
+            .iter()
+            .chain(self.d_prev.iter())
+            .enumerate()
+            .map(|(i, &x)| (super::BODY_DOFS[i % 4], x, BODY_DISPLACEMENT_LIMIT))
+            .find(|&(_, x, l)| !within(x, l))
     }
 
     /// Which side holds the primary suspension.

@@ -103,11 +103,15 @@ impl FmuModel {
                 _ => f64::NAN,
             },
         };
+        // The primary forces: the vehicle's, the axle-box interface's mean since the
+        // last input, or 0 where the track carries no primary suspension (TrackContact
+        // with the contact interface).
         let bearing = || match view {
             View::Vehicle(u) => u.bearing_forces()[side],
             View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
                 Some(VehicleState::RollPlane(v)) => v.bearing_forces()[side],
-                _ => f64::NAN,
+                Some(VehicleState::AxleBox(link)) => link.mean_force()[side],
+                _ => 0.0,
             },
         };
         let extremes = |sim: &Simulation| {
@@ -162,8 +166,32 @@ impl FmuModel {
             Quantity::WheelsetZ => body(4),
             Quantity::WheelsetRoll => body(5),
             Quantity::PrimaryForce => bearing(),
+            Quantity::SideframeV => match view {
+                View::Vehicle(u) => u.side_frames().1[side],
+                View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                    Some(VehicleState::RollPlane(v)) => v.velocities()[2 + side],
+                    _ => f64::NAN,
+                },
+            },
             // Observation points: `site_value` above.
-            _ => f64::NAN,
+            Quantity::SiteRailZ
+            | Quantity::SiteRailZMax
+            | Quantity::SiteRailZMin
+            | Quantity::SiteRailBendingMoment
+            | Quantity::SiteRailBendingMomentMax
+            | Quantity::SiteRailBendingMomentMin
+            | Quantity::SiteRailShearForce
+            | Quantity::SiteRailShearForceMax
+            | Quantity::SiteRailShearForceMin
+            | Quantity::SiteSeatForce
+            | Quantity::SiteSeatForceMax
+            | Quantity::SiteSeatForceMin
+            | Quantity::SiteSeatZ
+            | Quantity::SiteSeatZMax
+            | Quantity::SiteSeatZMin
+            | Quantity::SiteBallastForce
+            | Quantity::SiteBallastForceMax
+            | Quantity::SiteBallastForceMin => f64::NAN,
         }
     }
 }

@@ -56,6 +56,33 @@ pub fn vehicle_params(v: &[f64]) -> RollPlaneParams {
     }
 }
 
+/// Whether the FMU couples at the axle boxes (`interface = axle_box`).
+pub fn axle_box(v: &[f64]) -> bool {
+    v[vr::INTERFACE as usize] == enums::interface::AXLE_BOX
+}
+
+/// TrackContact's wheelset and primary suspension (`interface = axle_box`), in the
+/// roll-plane vehicle's parameters: the bodies above it are the partner's (zero here,
+/// unused).
+pub fn wheelset_params(v: &[f64]) -> RollPlaneParams {
+    let v = |r: u32| v[r as usize];
+    RollPlaneParams {
+        carbody_mass: 0.0,
+        bolster_mass: 0.0,
+        bolster_inertia: 0.0,
+        sideframe_mass: 0.0,
+        wheelset_mass: v(vr::VEHICLE_WHEELSET_MASS),
+        wheelset_inertia: v(vr::VEHICLE_WHEELSET_INERTIA),
+        primary_stiffness: v(vr::VEHICLE_PRIMARY_STIFFNESS),
+        primary_damping: v(vr::VEHICLE_PRIMARY_DAMPING),
+        primary_spacing: v(vr::VEHICLE_PRIMARY_SPACING),
+        secondary_stiffness: 0.0,
+        secondary_damping: 0.0,
+        secondary_spacing: 0.0,
+        gravity: v(vr::GRAVITY),
+    }
+}
+
 /// The vehicle as a co-simulation unit (RollPlaneVehicle).
 pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
     VehicleUnitParams {
@@ -67,6 +94,7 @@ pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
             v[vr::STATIC_WHEEL_Z_LEFT as usize],
             v[vr::STATIC_WHEEL_Z_RIGHT as usize],
         ],
+        axle_box: axle_box(v),
     }
 }
 
@@ -106,11 +134,14 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         .iter()
         .map(|&r| val(r))
         .collect();
+    let static_load = [val(vr::STATIC_LOAD_LEFT), val(vr::STATIC_LOAD_RIGHT)];
     let vehicle = match kind {
         Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
-        _ => VehicleSpec::External {
-            static_load: [val(vr::STATIC_LOAD_LEFT), val(vr::STATIC_LOAD_RIGHT)],
+        _ if axle_box(v) => VehicleSpec::AxleBox {
+            vehicle: wheelset_params(v),
+            static_load,
         },
+        _ => VehicleSpec::External { static_load },
     };
     Scenario {
         name: kind.table().model_identifier.into(),

@@ -7,7 +7,7 @@ use super::outputs::Published;
 use super::parameters::{scenario, vehicle_unit_params};
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
-use crate::fmu::vars::{FmuTable, TRAILING, TRAILING_INPUT_VRS, VarSpec, vr};
+use crate::fmu::vars::{FmuTable, TRAILING, TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, VarSpec, vr};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
 use crate::sim::{Sample, Simulation, TrackSpec, VehicleUnit};
 
@@ -15,6 +15,15 @@ use crate::sim::{Sample, Simulation, TrackSpec, VehicleUnit};
 /// end's reflections raise the forces (the default start position, 1.37 m, is two
 /// spans from the other end).
 pub const END_ZONE_SPANS: f64 = 2.0;
+
+/// TrackContact's side-frame inputs of the leading wheelset (`interface = axle_box`):
+/// left and right displacement, left and right velocity.
+const FRAME_VRS: [u32; 4] = [
+    vr::SIDEFRAME_LEFT_Z,
+    vr::SIDEFRAME_RIGHT_Z,
+    vr::SIDEFRAME_LEFT_V,
+    vr::SIDEFRAME_RIGHT_V,
+];
 
 /// The engine behind an FMU.
 #[derive(Debug, Clone)]
@@ -141,6 +150,17 @@ impl Model for FmuModel {
                     return Ok(());
                 }
                 let changed_any = |a: u32, b: u32| changed.iter().any(|&r| r == a || r == b);
+                let n = sim.wheelsets().len();
+                if sim.primary_of(0).is_some() {
+                    // The axle-box interface: the side frames of each wheelset.
+                    let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
+                    for (k, [zl, zr, vl, vr_]) in frames.take(n).enumerate() {
+                        if changed_any(zl, zr) || changed_any(vl, vr_) {
+                            sim.set_side_frames_of(k, [v(zl), v(zr)], [v(vl), v(vr_)])?;
+                        }
+                    }
+                    return Ok(());
+                }
                 if changed_any(vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z) {
                     sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
                 }
@@ -149,7 +169,6 @@ impl Model for FmuModel {
                 }
                 // The wheelsets behind the leading one; the inputs of a wheelset the
                 // model does not have are kept and unused.
-                let n = sim.wheelsets().len();
                 for (k, &[left, right, rotation]) in (1..n).zip(&TRAILING_INPUT_VRS) {
                     if changed_any(left, right) {
                         sim.set_wheel_z_of(k, [v(left), v(right)])?;
@@ -160,6 +179,9 @@ impl Model for FmuModel {
                 }
                 Ok(())
             }
+            (Engine::Vehicle(u), _) if u.is_axle_box() => {
+                u.set_forces([v(vr::AXLE_BOX_LEFT_FORCE), v(vr::AXLE_BOX_RIGHT_FORCE)])
+            }
             (Engine::Vehicle(u), _) => {
                 u.set_forces([v(vr::CONTACT_LEFT_FORCE), v(vr::CONTACT_RIGHT_FORCE)])
             }
@@ -169,9 +191,26 @@ impl Model for FmuModel {
     /// TrackContact's wheel heights not set by the master: the static heights of the
     /// wheelset's wheels, so that an unconnected wheel starts at rest.
     fn input_at_rest(&self, r: u32) -> Option<f64> {
+        if let Engine::Vehicle(u) = &self.engine {
+            // The axle-box interface's primary forces at rest.
+            let f = u.bearing_forces();
+            return match r {
+                vr::AXLE_BOX_LEFT_FORCE if u.is_axle_box() => Some(f[0]),
+                vr::AXLE_BOX_RIGHT_FORCE if u.is_axle_box() => Some(f[1]),
+                _ => None,
+            };
+        }
         let sim = self.simulation()?;
         if self.kind != Kind::TrackContact {
             return None;
+        }
+        // The axle-box interface's side frames at rest.
+        let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
+        for (k, [zl, zr, _, _]) in frames.enumerate() {
+            if r == zl || r == zr {
+                let (z, _) = sim.side_frames_of(k)?;
+                return Some(if r == zl { z[0] } else { z[1] });
+            }
         }
         let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
         let inputs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
