@@ -244,14 +244,15 @@ PRIMARY = ("primary.left.force", "primary.right.force")
 AXLE_BOX = ("axle_box.left.force", "axle_box.right.force")
 
 
-def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None):
+def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None, record=None):
     """Couples TrackContact and RollPlaneVehicle at the axle boxes (``interface`` =
     axle_box): TrackContact carries the wheelset and its primary suspension,
     RollPlaneVehicle the bodies above. Per communication step: the side frames' motion
     (``sideframe.*.z``, ``.v``) to the track, the track steps, its mean primary forces
     over that step (``primary.*.force``) to the vehicle (``axle_box.*.force``), the
     vehicle steps (track first: a Gauss-Seidel exchange). Returns the track's largest
-    contact forces ``[left, right]`` (N) over the run."""
+    contact forces ``[left, right]`` (N) over the run; ``record``, a list, receives
+    ``[time, contact forces, mean primary forces]`` at every communication point."""
     tp = dict(track_params or {}, interface=2)
     vp = dict(vehicle_params or {}, interface=2)
     track = Unit(paths["TrackContact"], "track")
@@ -276,6 +277,8 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
             track.fmu.doStep(t, comm_step)
             vehicle.set(AXLE_BOX, track.get(*PRIMARY))
             vehicle.fmu.doStep(t, comm_step)
+            if record is not None:
+                record.append([t + comm_step] + track.get(*FORCES, *PRIMARY))
         return track.get("contact.left.max_force", "contact.right.max_force")
     finally:
         track.close()
