@@ -2,7 +2,7 @@
 //! (table 4.4, 70 km/h, 100 mm x 1.5 mm flat) with the roll-plane vehicle cut above its
 //! primary suspension: the wheelset and the primary suspension ride with the track on
 //! its step (`VehicleSpec::AxleBox`), the bolster and side frames
-//! (`SprungBogie::force_driven`, 0.5 ms substeps) exchange their side frames' motion for
+//! (`SprungBogie::new`, 0.5 ms substeps) exchange their side frames' motion for
 //! the mean primary forces every `h`, against the monolithic run over 0.8 s: the peak's
 //! error and the largest difference of the contact-force history over the static load.
 //! `cargo run --release --example axle_box_coupling`
@@ -42,7 +42,7 @@ fn main() {
         let per = (h / dt).round().max(1.0) as u64;
         let h = per as f64 * dt;
         let sub = (h / 5e-4).ceil() as usize;
-        let mut bogie = SprungBogie::force_driven(p, h / sub as f64).unwrap();
+        let mut bogie = SprungBogie::new(p, h / sub as f64).unwrap();
         bogie.set_static(sim.primary_of(0).unwrap().1).unwrap();
         let mut f = Vec::new();
         let mut failed = None;
@@ -65,7 +65,7 @@ fn main() {
             }
             let (primary, _, _) = sim.primary_of(0).unwrap();
             for _ in 0..sub {
-                bogie.step_forced(primary);
+                bogie.step(primary);
             }
         }
         let n = f.len().min(reference.len());

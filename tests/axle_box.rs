@@ -1,7 +1,7 @@
 //! The axle-box interface: the roll-plane vehicle cut above its primary suspension, the
 //! wheelset and the primary suspension riding with the track (`VehicleSpec::AxleBox`,
 //! `PrimaryLink`) and the bodies above a co-simulation partner
-//! (`SprungBogie::force_driven`) that exchanges its side frames' motion for the mean
+//! (`SprungBogie::new`) that exchanges its side frames' motion for the mean
 //! primary forces every communication step. Against the monolithic run (the same
 //! vehicle inside the engine): the static start, and the reference flat case's peak at
 //! the track's step and at a bogie model's 1 ms.
@@ -33,7 +33,7 @@ fn cut(h: f64, duration: f64, dt_bogie: f64) -> Vec<f64> {
     let per = (h / dt).round().max(1.0) as u64;
     let h = per as f64 * dt;
     let sub = (h / dt_bogie).ceil() as usize;
-    let mut bogie = SprungBogie::force_driven(p, h / sub as f64).unwrap();
+    let mut bogie = SprungBogie::new(p, h / sub as f64).unwrap();
     let (_, z0, _) = sim.primary_of(0).unwrap();
     bogie.set_static(z0).unwrap();
     let mut forces = Vec::new();
@@ -48,7 +48,7 @@ fn cut(h: f64, duration: f64, dt_bogie: f64) -> Vec<f64> {
         }
         let (f, _, _) = sim.primary_of(0).unwrap();
         for _ in 0..sub {
-            bogie.step_forced(f);
+            bogie.step(f);
         }
     }
     forces

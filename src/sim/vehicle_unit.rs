@@ -31,7 +31,7 @@ pub struct VehicleUnitParams {
     /// track computed them: the vehicle starts at rest on them.
     pub static_wheel_z: [f64; 2],
     /// The axle-box interface: the unit is the vehicle above its primary suspension
-    /// ([`crate::vehicle::SprungBogie::force_driven`]), the primary forces come in
+    /// ([`crate::vehicle::SprungBogie::new`]), the primary forces come in
     /// (held over each communication step) and the side frames' motion goes out; its
     /// partner carries the wheelset and the primary suspension
     /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
@@ -102,7 +102,7 @@ impl VehicleUnit {
         let mut vehicle = RollPlaneVehicle::new(p.vehicle, dt)?;
         vehicle.set_static(p.static_wheel_z)?;
         let sprung = if p.axle_box {
-            let mut b = SprungBogie::force_driven(p.vehicle, dt)?;
+            let mut b = SprungBogie::new(p.vehicle, dt)?;
             b.set_static(p.static_wheel_z)?;
             Some(b)
         } else {
@@ -273,7 +273,7 @@ impl VehicleUnit {
         match &mut self.sprung {
             Some(b) => {
                 for _ in 0..s.n as u64 {
-                    b.step_forced(self.force);
+                    b.step(self.force);
                     self.clock.tick();
                 }
             }

@@ -19,6 +19,7 @@
 use super::RollPlaneParams;
 use crate::error::{Result, out_of_range, positive};
 use crate::limits::{BODY_DISPLACEMENT_LIMIT, within};
+use crate::numerics::CentralDifference;
 use nalgebra::{Matrix4, Vector4};
 
 /// The wheelset of the roll-plane vehicle on its own: bounce and roll under the contact
@@ -322,50 +323,23 @@ impl PrimaryLink {
     }
 }
 
-/// The roll-plane vehicle above its wheelset, `d = {z_b, phi_b, z_sfl, z_sfr}` (the
-/// first four of (3.1)), with gravity, driven through the primary suspension by the axle
-/// boxes' displacements and velocities `[left, right]` (m, m/s), advanced by the central
-/// differences of the whole model with the damping as in (3.25). The primary forces it
-/// returns ([`SprungBogie::primary_forces`]) load the wheelset.
+/// The roll-plane vehicle above its primary suspension, `d = {z_b, phi_b, z_sfl,
+/// z_sfr}` (the first four of (3.1)), with gravity, driven by the primary forces
+/// `[left, right]` (N, pressing the axle boxes down, so pushing the side frames up) that
+/// its partner ([`PrimaryLink`]) computes, and advanced by the central differences of
+/// the whole model with the damping as in (3.25). Its side frames' motion
+/// ([`SprungBogie::side_frames`]) drives the primary suspension on the other side.
 #[derive(Debug, Clone)]
 pub struct SprungBogie {
     params: RollPlaneParams,
-    /// Whether the primary suspension is the bogie's (driven by the axle boxes'
-    /// motion) or the other side's (driven by the primary forces).
-    drive: BogieDrive,
-    dt: f64,
-    d: Vector4<f64>,
-    d_prev: Vector4<f64>,
-    p_cur: Matrix4<f64>,
-    p_prev: Matrix4<f64>,
-    p_force: Matrix4<f64>,
+    /// The bodies' displacements and the update of (3.25) without the primary
+    /// suspension.
+    cd: CentralDifference<4>,
     gravity: Vector4<f64>,
 }
 
-/// Which side of the cut holds the primary suspension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BogieDrive {
-    /// The bogie holds it: the axle boxes' displacements and velocities in, the
-    /// primary forces out.
-    BoxMotion,
-    /// The track side holds it: the primary forces in, the side frames' displacements
-    /// and velocities out.
-    PrimaryForce,
-}
-
 impl SprungBogie {
-    /// The bodies of `params` above the wheelset with the primary suspension on the
-    /// other side ([`BogieDrive::PrimaryForce`]), stepped with `dt` (s).
-    ///
-    /// Errors: as [`SprungBogie::new`].
-    pub fn force_driven(params: RollPlaneParams, dt: f64) -> Result<SprungBogie> {
-        let mut b = Self::new(params, dt)?;
-        b.drive = BogieDrive::PrimaryForce;
-        b.set_coefficients(dt);
-        Ok(b)
-    }
-
-    /// The bodies of `params` above the wheelset, stepped with `dt` (s).
+    /// The bodies of `params` above the primary suspension, stepped with `dt` (s).
     ///
     /// Errors: a parameter [`RollPlaneParams::validate`] refuses; `dt` not positive or
     /// above the whole vehicle's critical step.
@@ -374,59 +348,25 @@ impl SprungBogie {
         positive("solver.dt", dt, "s")?;
         params.check_time_step(dt)?;
         let g = params.gravity_force();
-        let mut b = SprungBogie {
-            params,
-            drive: BogieDrive::BoxMotion,
-            dt,
-            d: Vector4::zeros(),
-            d_prev: Vector4::zeros(),
-            p_cur: Matrix4::zeros(),
-            p_prev: Matrix4::zeros(),
-            p_force: Matrix4::zeros(),
-            gravity: Vector4::new(g[0], g[1], g[2], g[3]),
-        };
-        b.set_coefficients(dt);
-        Ok(b)
-    }
-
-    fn set_coefficients(&mut self, dt: f64) {
-        let p = &self.params;
-        let m = p.mass_diagonal();
-        let minv = Matrix4::from_diagonal(&Vector4::new(
-            1.0 / m[0],
-            1.0 / m[1],
-            1.0 / m[2],
-            1.0 / m[3],
-        ));
-        let (k, c) = self.matrices();
-        let id = Matrix4::<f64>::identity();
-        // As the whole vehicle (`RollPlaneVehicle`): M + dt/2 C is symmetric positive
-        // definite, so the inverse exists.
-        let inv = (id + minv * c * (0.5 * dt)).try_inverse().unwrap_or(id);
-        self.p_cur = inv * (id * 2.0 - minv * k * (dt * dt));
-        self.p_prev = inv * (minv * c * (0.5 * dt) - id);
-        self.p_force = inv * minv * (dt * dt);
-        self.dt = dt;
-    }
-
-    /// Stiffness and damping of the four bodies: the first four rows and columns of
-    /// (3.1), less the primary suspension when the other side holds it.
-    fn matrices(&self) -> (Matrix4<f64>, Matrix4<f64>) {
-        let p = &self.params;
-        let mut k: Matrix4<f64> = p.stiffness_matrix().fixed_view::<4, 4>(0, 0).into();
-        let mut c: Matrix4<f64> = p.damping_matrix().fixed_view::<4, 4>(0, 0).into();
-        if self.drive == BogieDrive::PrimaryForce {
-            for i in 2..4 {
-                k[(i, i)] -= p.primary_stiffness;
-                c[(i, i)] -= p.primary_damping;
-            }
+        let m = params.mass_diagonal();
+        // The first four rows and columns of (3.1), less the primary suspension,
+        // which is the other side's.
+        let mut k: Matrix4<f64> = params.stiffness_matrix().fixed_view::<4, 4>(0, 0).into();
+        let mut c: Matrix4<f64> = params.damping_matrix().fixed_view::<4, 4>(0, 0).into();
+        for i in 2..4 {
+            k[(i, i)] -= params.primary_stiffness;
+            c[(i, i)] -= params.primary_damping;
         }
-        (k, c)
+        Ok(SprungBogie {
+            params,
+            cd: CentralDifference::new(&Vector4::new(m[0], m[1], m[2], m[3]), k, c, dt),
+            gravity: Vector4::new(g[0], g[1], g[2], g[3]),
+        })
     }
 
     /// Step (s).
     pub fn dt(&self) -> f64 {
-        self.dt
+        self.cd.dt()
     }
 
     /// Changes the step to `dt` (s), keeping the displacements and the
@@ -436,96 +376,61 @@ impl SprungBogie {
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
         positive("solver.dt", dt, "s")?;
         self.params.check_time_step(dt)?;
-        let ratio = dt / self.dt;
-        self.d_prev = self.d - (self.d - self.d_prev) * ratio;
-        self.set_coefficients(dt);
+        self.cd.change_dt(dt);
         Ok(())
     }
 
     /// `[dt, d (4), d_prev (4)]`.
     pub fn state_vector(&self) -> Vec<f64> {
-        let mut v = vec![self.dt];
-        v.extend(self.d.iter());
-        v.extend(self.d_prev.iter());
-        v
+        self.cd.state_vector()
     }
 
     /// Restores [`SprungBogie::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        if v.len() != 9 {
+        let len = CentralDifference::<4>::STATE_LEN;
+        if v.len() != len {
             return Err(out_of_range(
                 "bogie state length",
                 v.len() as f64,
-                "9 values",
+                format!("{len} values"),
             ));
         }
-        if v[0] != self.dt {
+        if v[0] != self.dt() {
             self.change_dt(v[0])?;
         }
-        self.d = Vector4::from_column_slice(&v[1..5]);
-        self.d_prev = Vector4::from_column_slice(&v[5..9]);
+        self.cd.set_displacements_from(v);
         Ok(())
     }
 
     /// A displacement beyond [`BODY_DISPLACEMENT_LIMIT`], named as the roll-plane
     /// vehicle's.
     pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        self.d
+        self.cd
+            .d()
             .iter()
-            .chain(self.d_prev.iter())
+            .chain(self.cd.d_prev().iter())
             .enumerate()
             .map(|(i, &x)| (super::BODY_DOFS[i % 4], x, BODY_DISPLACEMENT_LIMIT))
             .find(|&(_, x, l)| !within(x, l))
     }
 
-    /// Which side holds the primary suspension.
-    pub fn drive(&self) -> BogieDrive {
-        self.drive
-    }
-
-    /// Advances one step from `t_j` under the primary forces `f` `[left, right]` (N,
-    /// pressing the axle boxes down, so pushing the side frames up) held over it
-    /// ([`BogieDrive::PrimaryForce`]).
-    pub fn step_forced(&mut self, f: [f64; 2]) {
-        let load = self.gravity + Vector4::new(0.0, 0.0, f[0], f[1]);
-        let next = self.p_cur * self.d + self.p_prev * self.d_prev + self.p_force * load;
-        self.d_prev = self.d;
-        self.d = next;
+    /// Advances one step from `t_j` under the primary forces `f` `[left, right]` (N)
+    /// held over it.
+    pub fn step(&mut self, f: [f64; 2]) {
+        self.cd
+            .advance(self.gravity + Vector4::new(0.0, 0.0, f[0], f[1]));
     }
 
     /// The side frames' displacements and velocities `[left, right]` (m, m/s) at `t_j`,
     /// the velocities backward differences over the last step.
     pub fn side_frames(&self) -> ([f64; 2], [f64; 2]) {
-        let v = (self.d - self.d_prev) / self.dt;
-        ([self.d[2], self.d[3]], [v[2], v[3]])
+        let (d, v) = (self.cd.d(), self.cd.velocities());
+        ([d[2], d[3]], [v[2], v[3]])
     }
 
     /// `{z_b, phi_b, z_sfl, z_sfr}` at `t_j` (m, rad).
     pub fn displacements(&self) -> &Vector4<f64> {
-        &self.d
-    }
-
-    /// The primary suspension's force on the side frames `[left, right]`' equations from
-    /// the axle boxes at `z_box` (m) moving at `v_box` (m/s): `K_1 z_box + C_1 v_box`
-    /// up on each side frame (the part of `-K d - C v` of (3.1) that the wheelset's
-    /// motion contributes).
-    fn box_drive(&self, z_box: [f64; 2], v_box: [f64; 2]) -> Vector4<f64> {
-        let (k1, c1) = (self.params.primary_stiffness, self.params.primary_damping);
-        Vector4::new(
-            0.0,
-            0.0,
-            k1 * z_box[0] + c1 * v_box[0],
-            k1 * z_box[1] + c1 * v_box[1],
-        )
-    }
-
-    /// Advances one step from `t_j` with the axle boxes at `z_box` (m) moving at `v_box`
-    /// (m/s), held over the step.
-    pub fn step(&mut self, z_box: [f64; 2], v_box: [f64; 2]) {
-        let f = self.gravity + self.box_drive(z_box, v_box);
-        let next = self.p_cur * self.d + self.p_prev * self.d_prev + self.p_force * f;
-        self.d_prev = self.d;
-        self.d = next;
+        self.cd.d()
     }
 
     /// Primary suspension forces `[left, right]` (N), positive pressing the axle boxes
@@ -533,14 +438,16 @@ impl SprungBogie {
     /// backward differences over the last step.
     pub fn primary_forces(&self, z_box: [f64; 2], v_box: [f64; 2]) -> [f64; 2] {
         let (k1, c1) = (self.params.primary_stiffness, self.params.primary_damping);
-        let v = (self.d - self.d_prev) / self.dt;
+        let (d, v) = self.side_frames();
         [
-            -(k1 * (self.d[2] - z_box[0]) + c1 * (v[2] - v_box[0])),
-            -(k1 * (self.d[3] - z_box[1]) + c1 * (v[3] - v_box[1])),
+            -(k1 * (d[0] - z_box[0]) + c1 * (v[0] - v_box[0])),
+            -(k1 * (d[1] - z_box[1]) + c1 * (v[1] - v_box[1])),
         ]
     }
 
-    /// Static equilibrium with the axle boxes held at `z_box` (m).
+    /// Static equilibrium with the axle boxes held at `z_box` (m): the bodies on their
+    /// secondary springs and on the primary springs to the axle boxes, `K d = F_gravity
+    /// + K_1 z_box` over the first four rows of (3.1).
     ///
     /// Errors: a suspension that does not hold the bodies.
     pub fn set_static(&mut self, z_box: [f64; 2]) -> Result<()> {
@@ -549,7 +456,8 @@ impl SprungBogie {
             .stiffness_matrix()
             .fixed_view::<4, 4>(0, 0)
             .into();
-        let rhs = self.gravity + self.box_drive(z_box, [0.0; 2]);
+        let k1 = self.params.primary_stiffness;
+        let rhs = self.gravity + Vector4::new(0.0, 0.0, k1 * z_box[0], k1 * z_box[1]);
         let d = k
             .lu()
             .solve(&rhs)
@@ -560,8 +468,7 @@ impl SprungBogie {
                         .into(),
                 )
             })?;
-        self.d = d;
-        self.d_prev = d;
+        self.cd.set_state(d, d);
         Ok(())
     }
 }

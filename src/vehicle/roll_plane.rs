@@ -6,6 +6,7 @@ use crate::error::{Error, Result, out_of_range, positive};
 use crate::limits::{
     BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, MAX_STATIC_DEFLECTION, check, within,
 };
+use crate::numerics::CentralDifference;
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 /// Parameters of the roll-plane vehicle (table 4.4 names).
@@ -214,14 +215,8 @@ pub const BODY_DOFS: [&str; 6] = [
 #[derive(Debug, Clone)]
 pub struct RollPlaneVehicle {
     params: RollPlaneParams,
-    dt: f64,
-    /// Displacements at t_j.
-    d: Vector6<f64>,
-    /// Displacements at t_(j-1).
-    d_prev: Vector6<f64>,
-    p_cur: Matrix6<f64>,
-    p_prev: Matrix6<f64>,
-    p_force: Matrix6<f64>,
+    /// The bodies' displacements at t_j and t_(j-1) and the update of (3.25).
+    cd: CentralDifference<6>,
     /// `p_force * gravity` over the bodies the contact forces do not act on (bolster
     /// and side frames): the step's constant part.
     p_gravity: Vector6<f64>,
@@ -234,45 +229,33 @@ impl RollPlaneVehicle {
         params.validate()?;
         positive("solver.dt", dt, "s")?;
         params.check_time_step(dt)?;
+        let cd = CentralDifference::new(
+            &params.mass_diagonal(),
+            params.stiffness_matrix(),
+            params.damping_matrix(),
+            dt,
+        );
         let mut v = RollPlaneVehicle {
             params,
-            dt,
-            d: Vector6::zeros(),
-            d_prev: Vector6::zeros(),
-            p_cur: Matrix6::zeros(),
-            p_prev: Matrix6::zeros(),
-            p_force: Matrix6::zeros(),
+            cd,
             p_gravity: Vector6::zeros(),
             gravity: params.gravity_force(),
         };
-        v.set_coefficients(dt);
+        v.set_p_gravity();
         Ok(v)
     }
 
-    /// Update matrices of (3.25) for step `dt` (s).
-    fn set_coefficients(&mut self, dt: f64) {
-        let params = &self.params;
-        let minv = Matrix6::from_diagonal(&params.mass_diagonal().map(|m| 1.0 / m));
-        let mc = minv * params.damping_matrix();
-        let mk = minv * params.stiffness_matrix();
-        let id = Matrix6::<f64>::identity();
-        // [I + dt/2 M^-1 C] d+ = dt^2 M^-1 F + [2I - dt^2 M^-1 K] d + [dt/2 M^-1 C - I] d-
-        // I + dt/2 M^-1 C is M^-1 (M + dt/2 C) with M + dt/2 C symmetric positive
-        // definite, hence regular; the identity fallback is never taken.
-        let inv = (id + mc * (0.5 * dt)).try_inverse().unwrap_or(id);
-        self.p_cur = inv * (id * 2.0 - mk * (dt * dt));
-        self.p_prev = inv * (mc * (0.5 * dt) - id);
-        self.p_force = inv * minv * (dt * dt);
+    /// The step's constant part for the update matrices in use.
+    fn set_p_gravity(&mut self) {
         let mut g = self.gravity;
         g[4] = 0.0;
         g[5] = 0.0;
-        self.p_gravity = self.p_force * g;
-        self.dt = dt;
+        self.p_gravity = self.cd.p_force() * g;
     }
 
     /// Time step (s).
     pub fn dt(&self) -> f64 {
-        self.dt
+        self.cd.dt()
     }
 
     /// Changes the time step to `dt` (s), keeping the displacements at t_j and the
@@ -280,35 +263,31 @@ impl RollPlaneVehicle {
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
         positive("solver.dt", dt, "s")?;
         self.params.check_time_step(dt)?;
-        let ratio = dt / self.dt;
-        self.d_prev = self.d - (self.d - self.d_prev) * ratio;
-        self.set_coefficients(dt);
+        self.cd.change_dt(dt);
+        self.set_p_gravity();
         Ok(())
     }
 
     /// Step, displacements at t_j and at t_(j-1): what [`RollPlaneVehicle::set_state_vector`]
     /// needs to continue exactly.
     pub fn state_vector(&self) -> Vec<f64> {
-        let mut v = vec![self.dt];
-        v.extend(self.d.iter());
-        v.extend(self.d_prev.iter());
-        v
+        self.cd.state_vector()
     }
 
     /// Restores a state written by [`RollPlaneVehicle::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        if v.len() != 13 {
+        let len = CentralDifference::<6>::STATE_LEN;
+        if v.len() != len {
             return Err(out_of_range(
                 "vehicle state length",
                 v.len() as f64,
-                "13 values",
+                format!("{len} values"),
             ));
         }
-        if v[0] != self.dt {
+        if v[0] != self.dt() {
             self.change_dt(v[0])?;
         }
-        self.d = Vector6::from_column_slice(&v[1..7]);
-        self.d_prev = Vector6::from_column_slice(&v[7..13]);
+        self.cd.set_displacements_from(v);
         Ok(())
     }
 
@@ -319,12 +298,12 @@ impl RollPlaneVehicle {
 
     /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad) at t_j.
     pub fn displacements(&self) -> &Vector6<f64> {
-        &self.d
+        self.cd.d()
     }
 
     /// Displacements at t_(j-1) (m, rad).
     pub fn previous_displacements(&self) -> &Vector6<f64> {
-        &self.d_prev
+        self.cd.d_prev()
     }
 
     /// The first displacement (name with unit, value, bound) beyond the health bounds of
@@ -332,7 +311,12 @@ impl RollPlaneVehicle {
     /// [`BODY_DISPLACEMENT_LIMIT`], a wheel centre beyond [`DISPLACEMENT_LIMIT`]; `None`
     /// when all are within them (and finite).
     pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        let bodies = self.d.iter().chain(self.d_prev.iter()).enumerate();
+        let bodies = self
+            .cd
+            .d()
+            .iter()
+            .chain(self.cd.d_prev().iter())
+            .enumerate();
         let w = self.wheel_z();
         bodies
             .map(|(i, &x)| (BODY_DOFS[i % 6], x, BODY_DISPLACEMENT_LIMIT))
@@ -345,20 +329,20 @@ impl RollPlaneVehicle {
 
     /// Velocities at t_j by backward difference (m/s, rad/s).
     pub fn velocities(&self) -> Vector6<f64> {
-        (self.d - self.d_prev) / self.dt
+        self.cd.velocities()
     }
 
     /// Sets displacements at t_j and t_(j-1).
     pub fn set_state(&mut self, d: Vector6<f64>, d_prev: Vector6<f64>) {
-        self.d = d;
-        self.d_prev = d_prev;
+        self.cd.set_state(d, d_prev);
     }
 
     /// Wheel-centre vertical displacements `[left, right]` (m) (3.2, 3.3).
     #[inline]
     pub fn wheel_z(&self) -> [f64; 2] {
         let h = 0.5 * self.params.primary_spacing;
-        [self.d[4] - h * self.d[5], self.d[4] + h * self.d[5]]
+        let d = self.cd.d();
+        [d[4] - h * d[5], d[4] + h * d[5]]
     }
 
     /// Generalised force vector `F` for contact forces `[P_l, P_r]` (N).
@@ -377,10 +361,9 @@ impl RollPlaneVehicle {
         // on the wheelset's bounce and roll only (where they nearly cancel its weight,
         // so those two entries are formed first, as in `force`).
         let f = self.force(p);
-        let pf = self.p_gravity + self.p_force.column(4) * f[4] + self.p_force.column(5) * f[5];
-        let next = self.p_cur * self.d + self.p_prev * self.d_prev + pf;
-        self.d_prev = self.d;
-        self.d = next;
+        let p_force = self.cd.p_force();
+        let pf = self.p_gravity + p_force.column(4) * f[4] + p_force.column(5) * f[5];
+        self.cd.advance_premultiplied(pf);
     }
 
     /// Primary suspension (bearing) forces `[left, right]` (N): the load the side frame
@@ -390,7 +373,8 @@ impl RollPlaneVehicle {
         let v = self.velocities();
         let h = 0.5 * p.primary_spacing;
         let side = |sf: usize, sgn: f64| {
-            let rel = self.d[sf] - (self.d[4] + sgn * h * self.d[5]);
+            let d = self.cd.d();
+            let rel = d[sf] - (d[4] + sgn * h * d[5]);
             let relv = v[sf] - (v[4] + sgn * h * v[5]);
             -(p.primary_stiffness * rel + p.primary_damping * relv)
         };
@@ -422,13 +406,13 @@ impl RollPlaneVehicle {
                 self.params.secondary_spacing
             )));
         };
-        self.d = Vector6::new(da[0], da[1], da[2], da[3], zw, phw);
-        self.d_prev = self.d;
+        let d = Vector6::new(da[0], da[1], da[2], da[3], zw, phw);
+        self.cd.set_state(d, d);
         Ok(())
     }
 
     /// Residual `F - K d` (N, N m) for contact forces `p`: zero in static equilibrium.
     pub fn static_residual(&self, p: [f64; 2]) -> Vector6<f64> {
-        self.force(p) - self.params.stiffness_matrix() * self.d
+        self.force(p) - self.params.stiffness_matrix() * self.cd.d()
     }
 }

@@ -1,0 +1,130 @@
+//! Central differences for a linear system `M x'' + C x' + K x = f` with a diagonal
+//! mass matrix, the damping taken implicitly as in the thesis' (3.25):
+//! `[I + dt/2 M^-1 C] x_(j+1) = dt^2 M^-1 f + [2 I - dt^2 M^-1 K] x_j + [dt/2 M^-1 C - I] x_(j-1)`.
+//! The vehicles' bodies use it (`crate::vehicle`).
+
+use nalgebra::{SMatrix, SVector};
+
+/// The state `x_j`, `x_(j-1)` of an `N`-degree-of-freedom system and the update
+/// matrices of its step `dt` (s).
+#[derive(Debug, Clone)]
+pub(crate) struct CentralDifference<const N: usize> {
+    mass_inv: SMatrix<f64, N, N>,
+    stiffness: SMatrix<f64, N, N>,
+    damping: SMatrix<f64, N, N>,
+    dt: f64,
+    d: SVector<f64, N>,
+    d_prev: SVector<f64, N>,
+    p_cur: SMatrix<f64, N, N>,
+    p_prev: SMatrix<f64, N, N>,
+    p_force: SMatrix<f64, N, N>,
+}
+
+impl<const N: usize> CentralDifference<N> {
+    /// Values of [`CentralDifference::state_vector`].
+    pub(crate) const STATE_LEN: usize = 1 + 2 * N;
+
+    /// The system of masses `mass` (the diagonal of `M`), stiffness `k` and damping `c`
+    /// at rest at zero, stepped with `dt` (s). The caller checks `dt` against the
+    /// system's stability limit.
+    pub(crate) fn new(
+        mass: &SVector<f64, N>,
+        k: SMatrix<f64, N, N>,
+        c: SMatrix<f64, N, N>,
+        dt: f64,
+    ) -> Self {
+        let mut s = CentralDifference {
+            mass_inv: SMatrix::from_diagonal(&mass.map(|m| 1.0 / m)),
+            stiffness: k,
+            damping: c,
+            dt,
+            d: SVector::zeros(),
+            d_prev: SVector::zeros(),
+            p_cur: SMatrix::zeros(),
+            p_prev: SMatrix::zeros(),
+            p_force: SMatrix::zeros(),
+        };
+        s.set_coefficients(dt);
+        s
+    }
+
+    fn set_coefficients(&mut self, dt: f64) {
+        let mc = self.mass_inv * self.damping;
+        let mk = self.mass_inv * self.stiffness;
+        let id = SMatrix::<f64, N, N>::identity();
+        // I + dt/2 M^-1 C is M^-1 (M + dt/2 C) with M + dt/2 C symmetric positive
+        // definite, hence regular; the identity fallback is never taken.
+        let inv = (id + mc * (0.5 * dt)).try_inverse().unwrap_or(id);
+        self.p_cur = inv * (id * 2.0 - mk * (dt * dt));
+        self.p_prev = inv * (mc * (0.5 * dt) - id);
+        self.p_force = inv * self.mass_inv * (dt * dt);
+        self.dt = dt;
+    }
+
+    /// Step (s).
+    pub(crate) fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// `x_j`.
+    pub(crate) fn d(&self) -> &SVector<f64, N> {
+        &self.d
+    }
+    /// `x_(j-1)`.
+    pub(crate) fn d_prev(&self) -> &SVector<f64, N> {
+        &self.d_prev
+    }
+    /// `dt^2 [I + dt/2 M^-1 C]^-1 M^-1`, the force's share of the update.
+    #[inline(always)]
+    pub(crate) fn p_force(&self) -> &SMatrix<f64, N, N> {
+        &self.p_force
+    }
+    /// Backward-difference velocities `(x_j - x_(j-1)) / dt`.
+    pub(crate) fn velocities(&self) -> SVector<f64, N> {
+        (self.d - self.d_prev) / self.dt
+    }
+    /// Sets `x_j` and `x_(j-1)`.
+    pub(crate) fn set_state(&mut self, d: SVector<f64, N>, d_prev: SVector<f64, N>) {
+        self.d = d;
+        self.d_prev = d_prev;
+    }
+
+    /// Advances one step with the force's share `pf` (`p_force f`, formed by the
+    /// caller).
+    #[inline(always)]
+    pub(crate) fn advance_premultiplied(&mut self, pf: SVector<f64, N>) {
+        let next = self.p_cur * self.d + self.p_prev * self.d_prev + pf;
+        self.d_prev = self.d;
+        self.d = next;
+    }
+
+    /// Advances one step under the force `f` held over it.
+    #[inline(always)]
+    pub(crate) fn advance(&mut self, f: SVector<f64, N>) {
+        self.advance_premultiplied(self.p_force * f);
+    }
+
+    /// Changes the step to `dt` (s), keeping `x_j` and the backward-difference
+    /// velocities: `x_(j-1)` moves to `x_j - (x_j - x_(j-1)) dt / dt_old` (first-order
+    /// accurate at the switch). The caller checks `dt`.
+    pub(crate) fn change_dt(&mut self, dt: f64) {
+        let ratio = dt / self.dt;
+        self.d_prev = self.d - (self.d - self.d_prev) * ratio;
+        self.set_coefficients(dt);
+    }
+
+    /// `[dt, x_j (N), x_(j-1) (N)]`.
+    pub(crate) fn state_vector(&self) -> Vec<f64> {
+        let mut v = vec![self.dt];
+        v.extend(self.d.iter());
+        v.extend(self.d_prev.iter());
+        v
+    }
+
+    /// Sets `x_j`, `x_(j-1)` from the tail of [`CentralDifference::state_vector`]
+    /// (`v` of [`CentralDifference::STATE_LEN`] values whose step the caller has
+    /// already taken over).
+    pub(crate) fn set_displacements_from(&mut self, v: &[f64]) {
+        self.d = SVector::from_column_slice(&v[1..1 + N]);
+        self.d_prev = SVector::from_column_slice(&v[1 + N..1 + 2 * N]);
+    }
+}
