@@ -124,8 +124,10 @@ def track_step(paths, track_params=None):
         u.close(terminate=False)
 
 
-def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
-    """Parameters, static-equilibrium handshake and the first exchange."""
+def static_handshake(track, vehicle, track_params=None, vehicle_params=None):
+    """Parameters and the static-equilibrium handshake, leaving both in initialization
+    mode: the vehicle's static wheel loads to the track, the track's static wheel
+    heights back."""
     for u in (track, vehicle):
         u.fmu.setupExperiment(startTime=0.0)
     track.set_parameters(track_params)
@@ -136,6 +138,11 @@ def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
     track.set(loads, vehicle.get(*loads))
     heights = ("static_wheel_z.left", "static_wheel_z.right")
     vehicle.set(heights, track.get(*heights))
+
+
+def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
+    """Parameters, static-equilibrium handshake and the first exchange."""
+    static_handshake(track, vehicle, track_params, vehicle_params)
     track.set(WHEELS, vehicle.get(*WHEELS))
     vehicle.set(FORCES, track.get(*FORCES))
     vehicle.fmu.exitInitializationMode()
@@ -258,16 +265,7 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
     track = Unit(paths["TrackContact"], "track")
     vehicle = Unit(paths["RollPlaneVehicle"], "vehicle")
     try:
-        for u in (track, vehicle):
-            u.fmu.setupExperiment(startTime=0.0)
-        track.set_parameters(tp)
-        vehicle.set_parameters(vp)
-        vehicle.fmu.enterInitializationMode()
-        track.fmu.enterInitializationMode()
-        loads = ("static_load.left", "static_load.right")
-        track.set(loads, vehicle.get(*loads))
-        heights = ("static_wheel_z.left", "static_wheel_z.right")
-        vehicle.set(heights, track.get(*heights))
+        static_handshake(track, vehicle, tp, vp)
         vehicle.fmu.exitInitializationMode()
         track.fmu.exitInitializationMode()
         n = int(round(stop_time / comm_step))

@@ -121,6 +121,15 @@ pub(super) struct Window {
     pub(super) spec: TrackWindow,
     pub(super) origin_span: i64,
     pub(super) shift_at: f64,
+    /// Sleeper spacing `a` (m): the window moves by whole spans.
+    pub(super) spacing: f64,
+}
+
+impl Window {
+    /// Line coordinate of the track's node 0 (m).
+    pub(super) fn origin(&self) -> f64 {
+        self.origin_span as f64 * self.spacing
+    }
 }
 
 /// A running coupled simulation: the track-carrying co-simulation unit, on the fixed
@@ -247,14 +256,6 @@ fn displacements_within(s: &Sample) -> bool {
         && within(zr[1], DISPLACEMENT_LIMIT)
 }
 
-/// Sleeper spacing `a` (m) of a discrete track; 1 for the lumped track.
-fn track_params_spacing(t: &TrackSpec) -> f64 {
-    match t {
-        TrackSpec::Discrete(p) => p.sleeper_spacing,
-        TrackSpec::Lumped(_) => 1.0,
-    }
-}
-
 /// Sets `p.spans` to the window `spec` around wheelsets `d_max` (m) long whose leading
 /// one starts at `x0` (m), and places the window: `ceil((ahead + behind + d_max) / a) +
 /// 1` spans, node 0 at the whole span `j = ceil((x0 - (L - ahead)) / a)`, so that at
@@ -291,6 +292,7 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
         spec,
         origin_span: j as i64,
         shift_at: len - spec.ahead,
+        spacing: a,
     })
 }
 
@@ -409,9 +411,7 @@ impl Simulation {
             })
             .collect::<Result<Vec<_>>>()?;
         let wheelsets = Wheelsets::new(lead, trailing);
-        let origin = window.map_or(0.0, |w: Window| {
-            w.origin_span as f64 * track_params_spacing(&track_spec)
-        });
+        let origin = window.map_or(0.0, |w: Window| w.origin());
         let track = match &track_spec {
             TrackSpec::Discrete(p) => {
                 p.validate()?;
@@ -999,16 +999,15 @@ impl Simulation {
     #[cold]
     #[inline(never)]
     fn move_window(&mut self) -> Result<()> {
+        let x = self.position();
         let (Some(w), TrackState::Discrete(t)) = (&mut self.window, &mut self.track) else {
             return Ok(());
         };
-        let a = t.params().sleeper_spacing;
-        let x = self.motion.x_ref + self.motion.speed * (self.clock.time() - self.motion.t_ref);
         let beyond = x - self.origin - w.shift_at;
-        let m = ((beyond / a).floor() as usize + 1).min(t.params().spans - 1);
+        let m = ((beyond / w.spacing).floor() as usize + 1).min(t.params().spans - 1);
         t.shift_spans(m)?;
         w.origin_span += m as i64;
-        self.origin = w.origin_span as f64 * a;
+        self.origin = w.origin();
         self.clear_cache();
         Ok(())
     }

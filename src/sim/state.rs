@@ -1,7 +1,6 @@
 //! The state vector of a simulation: everything that determines the continuation, so
 //! that a saved run continues bit for bit (FMU states).
 
-use super::TrackSpec;
 use super::clock::ForceExtremes;
 use super::simulation::{Motion, Simulation, TrackState, VehicleState};
 use super::sites::Site;
@@ -144,9 +143,9 @@ impl Simulation {
             }
         }
         self.motion = Motion::from_slice(tail);
-        if let (Some(w), TrackSpec::Discrete(p)) = (&mut self.window, &self.scenario.track) {
+        if let Some(w) = &mut self.window {
             w.origin_span = origin_span as i64;
-            self.origin = w.origin_span as f64 * p.sleeper_spacing;
+            self.origin = w.origin();
         }
         let c = &mut self.clock;
         (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);

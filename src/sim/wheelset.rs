@@ -155,10 +155,6 @@ impl Wheelsets {
     pub(crate) fn trailing_mut(&mut self) -> &mut [Wheelset] {
         &mut self.trailing
     }
-    /// The distance from the leading wheelset to the last one (m).
-    pub fn length(&self) -> f64 {
-        self.iter().map(|w| w.offset).fold(0.0, f64::max)
-    }
     /// Number of wheelsets (at least 1).
     pub fn len(&self) -> usize {
         1 + self.trailing.len()

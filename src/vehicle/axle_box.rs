@@ -192,8 +192,6 @@ pub struct PrimaryLink {
     steps: u64,
     /// Sum of the primary forces over those steps (N).
     force_sum: [f64; 2],
-    /// The primary forces of the last step (N).
-    force: [f64; 2],
 }
 
 impl PrimaryLink {
@@ -212,7 +210,6 @@ impl PrimaryLink {
             frame_v: [0.0; 2],
             steps: 0,
             force_sum: [0.0; 2],
-            force: [0.0; 2],
         })
     }
 
@@ -229,7 +226,6 @@ impl PrimaryLink {
         let zb = self.body.wheel_z();
         self.frame_z = [0, 1].map(|i| zb[i] - f[i] / self.stiffness);
         self.frame_v = [0.0; 2];
-        self.force = f;
         self.force_sum = [0.0; 2];
         self.steps = 0;
     }
@@ -274,7 +270,6 @@ impl PrimaryLink {
     pub fn step(&mut self, p: [f64; 2]) {
         let f = self.forces_now();
         self.body.step(p, f);
-        self.force = f;
         self.force_sum[0] += f[0];
         self.force_sum[1] += f[1];
         self.steps += 1;
@@ -293,24 +288,23 @@ impl PrimaryLink {
     }
 
     /// The wheelset's state, then the side frames (z, v), the steps and force sums
-    /// since the last input, and the last forces: 14 values.
+    /// since the last input: 12 values.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = self.body.state_vector();
         v.extend(self.frame_z);
         v.extend(self.frame_v);
         v.push(self.steps as f64);
         v.extend(self.force_sum);
-        v.extend(self.force);
         v
     }
 
     /// Restores [`PrimaryLink::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        if v.len() != 14 || !crate::limits::is_count(v[9]) {
+        if v.len() != 12 || !crate::limits::is_count(v[9]) {
             return Err(out_of_range(
                 "primary suspension state",
                 v.len() as f64,
-                "14 values, a whole step count",
+                "12 values, a whole step count",
             ));
         }
         self.body.set_state_vector(&v[..5])?;
@@ -318,7 +312,6 @@ impl PrimaryLink {
         self.frame_v = [v[7], v[8]];
         self.steps = v[9] as u64;
         self.force_sum = [v[10], v[11]];
-        self.force = [v[12], v[13]];
         Ok(())
     }
 }

@@ -9,7 +9,7 @@ use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
 use crate::fmu::vars::{FmuTable, TRAILING, TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, VarSpec, vr};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
-use crate::sim::{Sample, Simulation, TrackSpec, VehicleUnit};
+use crate::sim::{Sample, Simulation, TrackSpec, VehicleState, VehicleUnit};
 
 /// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
 /// end's reflections raise the forces (the default start position, 1.37 m, is two
@@ -151,7 +151,7 @@ impl Model for FmuModel {
                 }
                 let changed_any = |a: u32, b: u32| changed.iter().any(|&r| r == a || r == b);
                 let n = sim.wheelsets().len();
-                if sim.primary_of(0).is_some() {
+                if matches!(sim.vehicle(), VehicleState::AxleBox(_)) {
                     // The axle-box interface: the side frames of each wheelset.
                     let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
                     for (k, [zl, zr, vl, vr_]) in frames.take(n).enumerate() {
