@@ -33,6 +33,8 @@ fn main() -> Result<(), wheelflat::Error> {
         dt: 0.0,
         static_wheel_z: track.wheel_z(),
         axle_box: false,
+        half_car: None,
+        trailing_static_wheel_z: [0.0; 2],
     })?;
     let h = per_exchange as f64 * track.dt();
     let revolution = std::f64::consts::TAU * scenario.wheel_radius / scenario.speed;

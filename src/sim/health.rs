@@ -33,6 +33,10 @@ impl Simulation {
                 VehicleState::AxleBox(link) => link.body().beyond_bounds(),
                 _ => None,
             };
+            let beyond = beyond.or_else(|| match (&self.bogie, k) {
+                (Some(b), 0) => b.beyond_bounds(),
+                _ => None,
+            });
             if let Some((what, value, limit)) = beyond {
                 return Err(Error::Diverged {
                     what: format!("vehicle {what}{}", Self::of_wheelset(k)),

@@ -11,7 +11,7 @@
 
 use crate::contact::ContactModel;
 use crate::track::{RailEnds, RailSection, TrackParams};
-use crate::vehicle::{LumpedTrackParams, LumpedWheelParams, RollPlaneParams};
+use crate::vehicle::{HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams};
 use crate::wheel::FlatSpec;
 
 /// Which track model carries the loads.
@@ -28,6 +28,10 @@ pub enum TrackSpec {
 pub enum VehicleSpec {
     /// The six-DOF roll-plane vehicle (chapter 3).
     RollPlane(RollPlaneParams),
+    /// The half-car bogie (thesis figure 1.10, [`crate::vehicle::HalfCarBogie`]) on
+    /// two wheelsets: the leading one and one trailing wheelset at the bogie's
+    /// wheelbase ([`Scenario::trailing`]).
+    HalfCar(HalfCarParams),
     /// The chapter-2 lumped wheel on each rail.
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).

@@ -18,7 +18,7 @@ use crate::limits::{
 };
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, SimdLevel, Track, TrackParams};
-use crate::vehicle::{LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
 /// Track state of a simulation.
@@ -46,6 +46,12 @@ pub enum VehicleState {
     /// above it outside ([`crate::vehicle::PrimaryLink`]): the side frames' motion is
     /// the input, the primary forces the output.
     AxleBox(crate::vehicle::PrimaryLink),
+    /// A wheelset of the half-car bogie ([`Simulation::bogie`]), which moves its
+    /// wheels: their displacements `[left, right]` (m) after the bogie's last step.
+    OnBogie {
+        /// Wheel-centre displacements `[left, right]` (m).
+        wheel_z: [f64; 2],
+    },
     /// Wheels moved from outside.
     External {
         /// Wheel-centre displacements `[left, right]` (m), inputs.
@@ -62,12 +68,14 @@ impl VehicleState {
     /// Wheel-centre displacements `[left, right]` (m); `None` for constant loads (the
     /// wheels then ride on the rail).
     #[inline(always)]
-    fn wheel_z(&self) -> Option<[f64; 2]> {
+    pub(super) fn wheel_z(&self) -> Option<[f64; 2]> {
         match self {
             VehicleState::RollPlane(v) => Some(v.wheel_z()),
             VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
             VehicleState::ConstantLoad(_) => None,
-            VehicleState::External { wheel_z, .. } => Some(*wheel_z),
+            VehicleState::External { wheel_z, .. } | VehicleState::OnBogie { wheel_z } => {
+                Some(*wheel_z)
+            }
             VehicleState::AxleBox(link) => Some(link.body().wheel_z()),
         }
     }
@@ -79,7 +87,9 @@ impl VehicleState {
             VehicleState::RollPlane(v) => v.step(p),
             VehicleState::LumpedWheels(v) => v.step(p),
             VehicleState::AxleBox(link) => link.step(p),
-            VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+            VehicleState::ConstantLoad(_)
+            | VehicleState::External { .. }
+            | VehicleState::OnBogie { .. } => {}
         }
     }
 }
@@ -163,6 +173,8 @@ pub struct Simulation {
     pub(super) simd: SimdLevel,
     /// The observation points ([`Scenario::sites`]).
     pub(super) sites: Vec<Site>,
+    /// The half-car bogie that moves the two wheelsets ([`VehicleSpec::HalfCar`]).
+    pub(super) bogie: Option<Box<HalfCarBogie>>,
 }
 
 /// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]).
@@ -393,6 +405,7 @@ impl Simulation {
                 VehicleSpec::AxleBox { vehicle, .. } => {
                     VehicleState::AxleBox(crate::vehicle::PrimaryLink::new(vehicle, dt)?)
                 }
+                VehicleSpec::HalfCar(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
@@ -411,6 +424,10 @@ impl Simulation {
             })
             .collect::<Result<Vec<_>>>()?;
         let wheelsets = Wheelsets::new(lead, trailing);
+        let bogie = match &s.vehicle {
+            VehicleSpec::HalfCar(p) => Some(Box::new(half_car_on(p, s, dt)?)),
+            _ => None,
+        };
         let origin = window.map_or(0.0, |w: Window| w.origin());
         let track = match &track_spec {
             TrackSpec::Discrete(p) => {
@@ -471,6 +488,7 @@ impl Simulation {
             force_limit: force_limit(static_load),
             simd: SimdLevel::detect(),
             sites: Vec::new(),
+            bogie,
         };
         sim.set_static()?;
         sim.check_static_sag()?;
@@ -967,6 +985,9 @@ impl Simulation {
         let lead = self.wheelsets.lead_mut();
         lead.extremes.record(p);
         lead.vehicle.step(p);
+        if self.bogie.is_some() {
+            self.step_bogie();
+        }
         match &mut self.track {
             TrackState::Discrete(t) => {
                 wheel_loads(
@@ -1032,7 +1053,9 @@ impl Simulation {
             match &mut w.vehicle {
                 VehicleState::RollPlane(v) => v.change_dt(dt)?,
                 VehicleState::AxleBox(link) => link.change_dt(dt)?,
-                VehicleState::ConstantLoad(_) | VehicleState::External { .. } => {}
+                VehicleState::ConstantLoad(_)
+                | VehicleState::External { .. }
+                | VehicleState::OnBogie { .. } => {}
                 VehicleState::LumpedWheels(_) => {
                     return Err(Error::Unsupported(
                         "changing the step of the lumped wheels".into(),
@@ -1040,9 +1063,42 @@ impl Simulation {
                 }
             }
         }
+        if let Some(b) = &mut self.bogie {
+            b.change_dt(dt)?;
+        }
         self.clock.restart(dt);
         self.clear_cache();
         Ok(())
+    }
+
+    /// The half-car bogie, when it carries the wheelsets
+    /// ([`VehicleSpec::HalfCar`]).
+    pub fn bogie(&self) -> Option<&HalfCarBogie> {
+        self.bogie.as_deref()
+    }
+
+    /// Advances the half-car bogie one step under the contact forces of its two
+    /// wheelsets' samples at `t_j`, then moves their wheels.
+    #[inline(never)]
+    fn step_bogie(&mut self) {
+        let p = [0, 1].map(|k| self.wheelsets.get(k).map_or([0.0; 2], Wheelset::forces));
+        if let Some(b) = &mut self.bogie {
+            b.step(p);
+        }
+        self.sync_bogie_wheels();
+    }
+
+    /// The bogie's wheel displacements into its wheelsets.
+    pub(super) fn sync_bogie_wheels(&mut self) {
+        let Some(b) = &self.bogie else { return };
+        let z = b.wheel_z();
+        for (k, zk) in z.into_iter().enumerate() {
+            if let Some(VehicleState::OnBogie { wheel_z }) =
+                self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
+            {
+                *wheel_z = zk;
+            }
+        }
     }
 
     /// Runs for `duration` (s) from now, rounded to a whole number of steps of
@@ -1061,4 +1117,29 @@ impl Simulation {
         }
         Ok(())
     }
+}
+
+/// The half-car bogie of `p` for the scenario `s`, stepped with `dt` (s): it needs
+/// exactly two wheelsets, the trailing one at the bogie's wheelbase.
+///
+/// Errors: another number of wheelsets (named `wheelsets`), a trailing offset other
+/// than the wheelbase (named `wheelset[2].offset`), the bogie's own refusals
+/// ([`HalfCarBogie::new`]).
+fn half_car_on(p: &crate::vehicle::HalfCarParams, s: &Scenario, dt: f64) -> Result<HalfCarBogie> {
+    if s.trailing.len() != 1 {
+        return Err(out_of_range(
+            "wheelsets",
+            (s.trailing.len() + 1) as f64,
+            "2 with the half-car bogie (vehicle.model = half_car): its two wheelsets",
+        ));
+    }
+    let offset = s.trailing[0].offset;
+    if (offset - p.wheelbase).abs() > 1e-9 * p.wheelbase {
+        return Err(out_of_range(
+            "wheelset[2].offset",
+            offset,
+            format!("the half-car bogie's wheelbase, {} m", num(p.wheelbase)),
+        ));
+    }
+    HalfCarBogie::new(*p, dt)
 }

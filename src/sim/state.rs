@@ -20,7 +20,10 @@ impl Simulation {
     /// axle angle (rad) and the time (s) it was given at), the motion (position (m)
     /// and time (s) of the speed's last change, the speed (m/s), the rolling axles'
     /// angle then (rad)) and the endless track's window (its first node, in whole
-    /// sleeper spans; 0 on a fixed track). [`Simulation::set_state_vector`] restores it exactly.
+    /// sleeper spans; 0 on a fixed track), then the half-car bogie's state when it
+    /// carries the wheelsets (its step and displacements at `t_j` and `t_(j-1)`; a
+    /// wheelset on it has none of its own). [`Simulation::set_state_vector`] restores
+    /// it exactly.
     ///
     /// Errors: a lumped track or lumped wheels ([`Error::Unsupported`]); only the
     /// discrete track with the roll-plane vehicle, constant loads or external wheels
@@ -43,6 +46,9 @@ impl Simulation {
         }
         v.extend(self.motion.to_array());
         v.push(self.window.map_or(0.0, |w| w.origin_span as f64));
+        if let Some(b) = &self.bogie {
+            v.extend(b.state_vector());
+        }
         Ok(v)
     }
 
@@ -50,7 +56,7 @@ impl Simulation {
     fn vehicle_state(vehicle: &VehicleState) -> Result<Vec<f64>> {
         Ok(match vehicle {
             VehicleState::RollPlane(r) => r.state_vector(),
-            VehicleState::ConstantLoad(_) => Vec::new(),
+            VehicleState::ConstantLoad(_) | VehicleState::OnBogie { .. } => Vec::new(),
             VehicleState::External {
                 wheel_z,
                 rotation,
@@ -101,7 +107,8 @@ impl Simulation {
         let nw = self.wheelsets.len();
         let extremes_end = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
         let head = extremes_end + Site::STATE_LEN * self.sites.len();
-        let total = head + nt + nw * nv + Motion::LEN + 1;
+        let nb = self.bogie.as_ref().map_or(0, |b| b.state_vector().len());
+        let total = head + nt + nw * nv + Motion::LEN + 1 + nb;
         if v.len() != total {
             return Err(out_of_range(
                 "simulation state length",
@@ -109,7 +116,7 @@ impl Simulation {
                 format!("{total} values for this scenario"),
             ));
         }
-        let tail = &v[total - Motion::LEN - 1..];
+        let tail = &v[total - nb - Motion::LEN - 1..total - nb];
         let origin_span = tail[Motion::LEN];
         if !(tail.iter().all(|x| x.is_finite())
             && tail[2] >= 0.0
@@ -142,6 +149,10 @@ impl Simulation {
                 _ => {}
             }
         }
+        if let Some(b) = &mut self.bogie {
+            b.set_state_vector(&v[total - nb..])?;
+        }
+        self.sync_bogie_wheels();
         self.motion = Motion::from_slice(tail);
         if let Some(w) = &mut self.window {
             w.origin_span = origin_span as i64;

@@ -18,6 +18,7 @@ use crate::wheel::WheelProfile;
 pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
         VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::HalfCar(p) => [p.static_wheel_load(); 2],
         VehicleSpec::AxleBox { static_load, .. } => {
             non_negative("static_load.left", static_load[0], "N")?;
             non_negative("static_load.right", static_load[1], "N")?;
@@ -109,8 +110,20 @@ impl Simulation {
                 VehicleState::AxleBox(link) => link.set_static(zw, p),
                 VehicleState::LumpedWheels(v) => v.set_static(zw),
                 VehicleState::ConstantLoad(_) => {}
-                VehicleState::External { wheel_z, .. } => *wheel_z = zw,
+                VehicleState::External { wheel_z, .. } | VehicleState::OnBogie { wheel_z } => {
+                    *wheel_z = zw
+                }
             }
+        }
+        if let Some(b) = &mut self.bogie {
+            let z = [0, 1].map(|k| {
+                self.wheelsets
+                    .get(k)
+                    .and_then(|w| w.vehicle.wheel_z())
+                    .unwrap_or([0.0; 2])
+            });
+            b.set_static(z)?;
+            self.sync_bogie_wheels();
         }
         Ok(())
     }

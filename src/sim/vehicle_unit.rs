@@ -13,7 +13,10 @@ use crate::error::{Error, Result, finite, non_negative, num, out_of_range, posit
 use crate::limits::{
     MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
 };
-use crate::vehicle::{RollPlaneParams, RollPlaneVehicle, SprungBogie};
+use crate::vehicle::{
+    HalfCarBogie, HalfCarParams, HalfCarVector, Quad, RollPlaneParams, RollPlaneVehicle,
+    SprungBogie, SprungHalfCar,
+};
 use nalgebra::Vector6;
 
 /// Parameters of a [`VehicleUnit`].
@@ -37,32 +40,51 @@ pub struct VehicleUnitParams {
     /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
     /// contact forces in.
     pub axle_box: bool,
+    /// The half-car bogie ([`HalfCarParams::from_roll_plane`] of `vehicle`, with its
+    /// wheelbase and side frames' pitch inertia) instead of the roll-plane vehicle: two
+    /// wheelsets, four contact (or primary) forces in.
+    pub half_car: Option<HalfCarParams>,
+    /// The second wheelset's static wheel-centre displacements `[left, right]` (m), for
+    /// the half-car bogie.
+    pub trailing_static_wheel_z: [f64; 2],
 }
 
-/// The six-DOF roll-plane vehicle (3.1-3.3, 3.24-3.27) as a co-simulation unit: the
-/// contact forces `[left, right]` (N) come in and are held over each communication step;
-/// the wheel-centre displacements (m), the axle angle (rad) and the bodies' motion go
-/// out. It follows the master's clock in equal substeps of at most its base step
+/// What a [`VehicleUnit`] steps.
+#[derive(Debug, Clone)]
+enum Body {
+    /// The roll-plane vehicle, the contact forces in.
+    RollPlane,
+    /// The roll-plane vehicle above its primary suspension, the primary forces in.
+    Sprung(Box<SprungBogie>),
+    /// The half-car bogie, the four contact forces in.
+    HalfCar(Box<HalfCarBogie>),
+    /// The half-car bogie above its primary suspension, the four primary forces in.
+    SprungHalfCar(Box<SprungHalfCar>),
+}
+
+/// A vehicle as a co-simulation unit: the six-DOF roll-plane vehicle (3.1-3.3,
+/// 3.24-3.27) or the half-car bogie ([`HalfCarBogie`], two wheelsets). The contact
+/// forces `[left, right]` (N) of each wheelset come in and are held over each
+/// communication step (with the axle-box interface, the primary forces); the
+/// wheel-centre displacements (m), the axle angle (rad) and the bodies' motion go out.
+/// It follows the master's clock in equal substeps of at most its base step
 /// ([`VehicleUnit::plan_to`], [`VehicleUnit::advance`]).
 #[derive(Debug, Clone)]
 pub struct VehicleUnit {
     params: VehicleUnitParams,
+    /// The roll-plane vehicle: it steps with [`Body::RollPlane`]; otherwise it rests
+    /// on the static wheel heights (the wheelset's outputs of the axle-box interface).
     vehicle: RollPlaneVehicle,
-    /// With the axle-box interface: the bodies above the primary suspension, which step
-    /// instead of `vehicle` (then at rest on the static wheel heights).
-    sprung: Option<SprungBogie>,
+    body: Body,
     /// Equal substeps of at most the base step; steps shorter than
     /// [`MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
     /// vehicle's.
     clock: Clock,
-    force: [f64; 2],
-    extremes: ForceExtremes,
+    /// The held forces of each wheelset (N); the second is unused by the roll-plane
+    /// vehicle.
+    force: Quad,
+    extremes: [ForceExtremes; 2],
 }
-
-/// Values of a [`VehicleUnit`] state vector ahead of the vehicle's: the clock
-/// (`t0`, `k`, the carried time), then the held forces `[left, right]` (N), then the
-/// force extremes.
-const HEAD: usize = 3 + 2 + ForceExtremes::LEN;
 
 impl VehicleUnit {
     /// Builds the vehicle at rest on the static wheel displacements, carrying the static
@@ -78,12 +100,22 @@ impl VehicleUnit {
         check("static_wheel_z.left", p.static_wheel_z[0])?;
         check("static_wheel_z.right", p.static_wheel_z[1])?;
         p.vehicle.validate()?;
-        let critical = p.vehicle.critical_time_step();
-        let dt = if p.dt == 0.0 {
-            p.vehicle.default_dt()
-        } else {
-            p.dt
+        if let Some(h) = &p.half_car {
+            check(
+                "wheelset[2].static_wheel_z.left",
+                p.trailing_static_wheel_z[0],
+            )?;
+            check(
+                "wheelset[2].static_wheel_z.right",
+                p.trailing_static_wheel_z[1],
+            )?;
+            h.validate()?;
+        }
+        let (critical, default_dt) = match &p.half_car {
+            Some(h) => (h.critical_time_step(), h.default_dt()),
+            None => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
         };
+        let dt = if p.dt == 0.0 { default_dt } else { p.dt };
         if !(dt >= MIN_DT_FRACTION * critical && dt <= 0.5 * critical) {
             return Err(out_of_range(
                 "solver.dt",
@@ -92,34 +124,48 @@ impl VehicleUnit {
                     "0 (the default, {} s) or {} s <= solver.dt <= {} s (half the critical step \
                      {} s of the fastest suspension mode: the step changes that communication \
                      steps force stay stable below it)",
-                    num(p.vehicle.default_dt()),
+                    num(default_dt),
                     num(MIN_DT_FRACTION * critical),
                     num(0.5 * critical),
                     num(critical)
                 ),
             ));
         }
-        let mut vehicle = RollPlaneVehicle::new(p.vehicle, dt)?;
+        // The roll-plane vehicle is built for the roll-plane variants' outputs; its own
+        // critical step may be shorter than the half-car's step, so it rests on a step
+        // it accepts when it does not step.
+        let rest_dt = dt.min(0.5 * p.vehicle.critical_time_step());
+        let mut vehicle = RollPlaneVehicle::new(p.vehicle, rest_dt)?;
         vehicle.set_static(p.static_wheel_z)?;
-        let sprung = if p.axle_box {
-            let mut b = SprungBogie::new(p.vehicle, dt)?;
-            b.set_static(p.static_wheel_z)?;
-            Some(b)
-        } else {
-            None
-        };
-        // The held inputs start static: the contact forces, or the primary forces.
-        let w = match &sprung {
-            Some(_) => vehicle.bearing_forces(),
-            None => [p.vehicle.static_wheel_load(); 2],
+        let wheels = [p.static_wheel_z, p.trailing_static_wheel_z];
+        let mut force = [[p.vehicle.static_wheel_load(); 2]; 2];
+        let body = match (&p.half_car, p.axle_box) {
+            (None, false) => Body::RollPlane,
+            (None, true) => {
+                let mut b = SprungBogie::new(p.vehicle, dt)?;
+                b.set_static(p.static_wheel_z)?;
+                force[0] = vehicle.bearing_forces();
+                Body::Sprung(Box::new(b))
+            }
+            (Some(h), false) => {
+                let mut b = HalfCarBogie::new(*h, dt)?;
+                b.set_static(wheels)?;
+                force = h.static_contact_forces(b.displacements());
+                Body::HalfCar(Box::new(b))
+            }
+            (Some(h), true) => {
+                let mut b = SprungHalfCar::new(*h, dt)?;
+                force = b.set_static(wheels)?;
+                Body::SprungHalfCar(Box::new(b))
+            }
         };
         let unit = VehicleUnit {
             params: *p,
             vehicle,
-            sprung,
+            body,
             clock: Clock::new(dt, Stepping::Substeps),
-            force: w,
-            extremes: ForceExtremes::at(w),
+            force,
+            extremes: force.map(ForceExtremes::at),
         };
         unit.check_states()?;
         Ok(unit)
@@ -129,6 +175,10 @@ impl VehicleUnit {
     pub fn params(&self) -> &VehicleUnitParams {
         &self.params
     }
+    /// Number of wheelsets: 2 for the half-car bogie, 1 otherwise.
+    pub fn wheelsets(&self) -> usize {
+        if self.params.half_car.is_some() { 2 } else { 1 }
+    }
     /// Static load on each wheel `[left, right]` (N).
     pub fn static_load(&self) -> [f64; 2] {
         let w = self.params.vehicle.static_wheel_load();
@@ -137,6 +187,13 @@ impl VehicleUnit {
     /// Base step (s).
     pub fn dt_base(&self) -> f64 {
         self.clock.base
+    }
+    /// Critical step of the vehicle's explicit scheme (s).
+    pub fn critical_step(&self) -> f64 {
+        match &self.params.half_car {
+            Some(h) => h.critical_time_step(),
+            None => self.params.vehicle.critical_time_step(),
+        }
     }
     /// Time (s).
     pub fn time(&self) -> f64 {
@@ -150,74 +207,171 @@ impl VehicleUnit {
     pub fn rotation(&self) -> f64 {
         self.params.speed * self.time() / self.params.wheel_radius
     }
-    /// Wheel-centre displacements `[left, right]` (m).
+    /// Wheel-centre displacements `[left, right]` (m) of the leading wheelset.
     pub fn wheel_z(&self) -> [f64; 2] {
-        self.vehicle.wheel_z()
+        self.wheel_z_of(0).unwrap_or([0.0; 2])
     }
-    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad); with the
-    /// axle-box interface the wheelset's are its static ones (the partner carries it).
+    /// Wheel-centre displacements `[left, right]` (m) of wheelset `k` (0 the leading
+    /// one); the static ones with the axle-box interface (the partner carries the
+    /// wheelsets); `None` for a wheelset the vehicle does not have.
+    pub fn wheel_z_of(&self, k: usize) -> Option<[f64; 2]> {
+        if k >= self.wheelsets() {
+            return None;
+        }
+        Some(match &self.body {
+            Body::RollPlane | Body::Sprung(_) => self.vehicle.wheel_z(),
+            Body::HalfCar(b) => b.wheel_z()[k],
+            Body::SprungHalfCar(_) if k == 0 => self.params.static_wheel_z,
+            Body::SprungHalfCar(_) => self.params.trailing_static_wheel_z,
+        })
+    }
+    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad) of the
+    /// roll-plane vehicle; with the axle-box interface the wheelset's are its static
+    /// ones (the partner carries it). Zero for the half-car bogie
+    /// ([`VehicleUnit::half_car_displacements`]).
     pub fn displacements(&self) -> Vector6<f64> {
         let mut d = *self.vehicle.displacements();
-        if let Some(b) = &self.sprung {
-            d.fixed_rows_mut::<4>(0).copy_from(b.displacements());
+        match &self.body {
+            Body::RollPlane => {}
+            Body::Sprung(b) => d.fixed_rows_mut::<4>(0).copy_from(b.displacements()),
+            Body::HalfCar(_) | Body::SprungHalfCar(_) => d = Vector6::zeros(),
         }
         d
     }
-    /// Primary suspension (bearing) forces `[left, right]` (N), pressing the wheelset
-    /// down; with the axle-box interface the held inputs.
-    pub fn bearing_forces(&self) -> [f64; 2] {
-        match &self.sprung {
-            Some(_) => self.force,
-            None => self.vehicle.bearing_forces(),
+    /// Displacements of the half-car bogie (m, rad), in the order of
+    /// [`crate::vehicle::HALF_CAR_DOF_NAMES`]; with the axle-box interface the
+    /// wheelsets' are their static ones. `None` for the roll-plane vehicle.
+    pub fn half_car_displacements(&self) -> Option<HalfCarVector> {
+        let h = self.params.half_car.as_ref()?;
+        match &self.body {
+            Body::HalfCar(b) => Some(*b.displacements()),
+            Body::SprungHalfCar(b) => {
+                let mut d = h.static_state([
+                    self.params.static_wheel_z,
+                    self.params.trailing_static_wheel_z,
+                ])?;
+                d.fixed_rows_mut::<6>(0).copy_from(b.displacements());
+                Some(d)
+            }
+            _ => None,
         }
     }
+    /// Primary suspension (bearing) forces `[left, right]` (N) of the leading
+    /// wheelset, pressing it down; with the axle-box interface the held inputs.
+    pub fn bearing_forces(&self) -> [f64; 2] {
+        self.bearing_forces_of(0).unwrap_or([0.0; 2])
+    }
+    /// [`VehicleUnit::bearing_forces`] of wheelset `k`; `None` for a wheelset the
+    /// vehicle does not have.
+    pub fn bearing_forces_of(&self, k: usize) -> Option<[f64; 2]> {
+        if k >= self.wheelsets() {
+            return None;
+        }
+        Some(match &self.body {
+            Body::RollPlane => self.vehicle.bearing_forces(),
+            Body::Sprung(_) | Body::SprungHalfCar(_) => self.force[k],
+            Body::HalfCar(b) => b.bearing_forces()[k],
+        })
+    }
     /// The side frames' displacements and velocities `[left, right]` (m, m/s) at the
-    /// current time, the velocities backward differences over the last step.
+    /// current time above the leading wheelset's axle boxes, the velocities backward
+    /// differences over the last step.
     pub fn side_frames(&self) -> ([f64; 2], [f64; 2]) {
-        match &self.sprung {
-            Some(b) => b.side_frames(),
-            None => {
+        self.side_frames_of(0).unwrap_or(([0.0; 2], [0.0; 2]))
+    }
+    /// [`VehicleUnit::side_frames`] above wheelset `k`'s axle boxes (the half-car's
+    /// side frames pitch); `None` for a wheelset the vehicle does not have.
+    pub fn side_frames_of(&self, k: usize) -> Option<([f64; 2], [f64; 2])> {
+        if k >= self.wheelsets() {
+            return None;
+        }
+        Some(match &self.body {
+            Body::Sprung(b) => b.side_frames(),
+            Body::RollPlane => {
                 let (d, v) = (self.vehicle.displacements(), self.vehicle.velocities());
                 ([d[2], d[3]], [v[2], v[3]])
             }
-        }
+            Body::HalfCar(b) => {
+                let h = b.params();
+                let (d, v) = (b.displacements(), b.velocities());
+                let x = if k == 0 { 0.5 } else { -0.5 } * h.wheelbase;
+                (
+                    [d[2] + x * d[3], d[4] + x * d[5]],
+                    [v[2] + x * v[3], v[4] + x * v[5]],
+                )
+            }
+            Body::SprungHalfCar(b) => {
+                let (z, v) = b.side_frames();
+                (z[k], v[k])
+            }
+        })
     }
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
-        self.sprung.is_some()
+        matches!(self.body, Body::Sprung(_) | Body::SprungHalfCar(_))
     }
-    /// The held contact forces `[left, right]` (N); with the axle-box interface the
-    /// held primary forces.
+    /// The held contact forces `[left, right]` (N) of the leading wheelset; with the
+    /// axle-box interface the held primary forces.
     pub fn forces(&self) -> [f64; 2] {
-        self.force
+        self.force[0]
+    }
+    /// Largest contact force per wheel of wheelset `k` that has driven a step (N); the
+    /// static load before the first step.
+    pub fn max_force_of(&self, k: usize) -> [f64; 2] {
+        self.extremes[k.min(1)].max
+    }
+    /// Smallest contact force per wheel of wheelset `k` that has driven a step (N).
+    pub fn min_force_of(&self, k: usize) -> [f64; 2] {
+        self.extremes[k.min(1)].min
     }
     /// Largest contact force per wheel that has driven a step (N); the static load
     /// before the first step.
     pub fn max_force(&self) -> [f64; 2] {
-        self.extremes.max
+        self.max_force_of(0)
     }
     /// Smallest contact force per wheel that has driven a step (N); the static load
     /// before the first step.
     pub fn min_force(&self) -> [f64; 2] {
-        self.extremes.min
+        self.min_force_of(0)
     }
 
-    /// Sets the contact forces `[left, right]` (N) held over the next communication step.
-    ///
-    /// Errors: a force not finite, or beyond [`crate::limits::force_limit`] of the
-    /// static loads (20 times the larger, at least 2 MN), which no physical run reaches;
-    /// nothing is set then.
+    /// Sets the contact forces `[left, right]` (N) of the leading wheelset, held over
+    /// the next communication step. Errors as [`VehicleUnit::set_forces_of`].
     pub fn set_forces(&mut self, p: [f64; 2]) -> Result<()> {
+        self.set_forces_of(0, p)
+    }
+
+    /// Sets the contact forces `[left, right]` (N) of wheelset `k` (with the axle-box
+    /// interface the primary forces), held over the next communication step.
+    ///
+    /// Errors: a wheelset the vehicle does not have; a force not finite, or beyond
+    /// [`crate::limits::force_limit`] of the static loads (20 times the larger, at
+    /// least 2 MN), which no physical run reaches; nothing is set then.
+    pub fn set_forces_of(&mut self, k: usize, p: [f64; 2]) -> Result<()> {
+        if k >= self.wheelsets() {
+            return Err(out_of_range(
+                "wheelset",
+                k as f64 + 1.0,
+                format!("1 to {}", self.wheelsets()),
+            ));
+        }
         let lim = crate::limits::force_limit(self.static_load());
-        let names = match &self.sprung {
-            Some(_) => ["axle_box.left.force", "axle_box.right.force"],
-            None => ["contact.left.force", "contact.right.force"],
+        let kind = if self.is_axle_box() {
+            "axle_box"
+        } else {
+            "contact"
         };
-        for (name, x) in [(names[0], p[0]), (names[1], p[1])] {
-            finite(name, x, "N")?;
+        let prefix = if k == 0 {
+            String::new()
+        } else {
+            format!("wheelset[{}].", k + 1)
+        };
+        for (side, x) in [("left", p[0]), ("right", p[1])] {
+            let name = format!("{prefix}{kind}.{side}.force");
+            finite(&name, x, "N")?;
             if !crate::limits::within(x, lim) {
                 return Err(crate::error::out_of_range(
-                    name,
+                    &name,
                     x,
                     format!(
                         "|{name}| <= {} N ({} times the static wheel load), which no physical \
@@ -228,7 +382,7 @@ impl VehicleUnit {
                 ));
             }
         }
-        self.force = p;
+        self.force[k] = p;
         Ok(())
     }
 
@@ -263,26 +417,26 @@ impl VehicleUnit {
         }
         self.clock.carried = 0.0;
         if let Some(dt) = s.dt {
-            match &mut self.sprung {
-                Some(b) => b.change_dt(dt)?,
-                None => self.vehicle.change_dt(dt)?,
+            match &mut self.body {
+                Body::RollPlane => self.vehicle.change_dt(dt)?,
+                Body::Sprung(b) => b.change_dt(dt)?,
+                Body::HalfCar(b) => b.change_dt(dt)?,
+                Body::SprungHalfCar(b) => b.change_dt(dt)?,
             }
             self.clock.restart(dt);
         }
-        self.extremes.record(self.force);
-        match &mut self.sprung {
-            Some(b) => {
-                for _ in 0..s.n as u64 {
-                    b.step(self.force);
-                    self.clock.tick();
-                }
-            }
-            None => {
-                for _ in 0..s.n as u64 {
-                    self.vehicle.step(self.force);
-                    self.clock.tick();
-                }
-            }
+        for k in 0..self.wheelsets() {
+            self.extremes[k].record(self.force[k]);
+        }
+        let n = s.n as u64;
+        match &mut self.body {
+            Body::RollPlane => (0..n).for_each(|_| self.vehicle.step(self.force[0])),
+            Body::Sprung(b) => (0..n).for_each(|_| b.step(self.force[0])),
+            Body::HalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
+            Body::SprungHalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
+        }
+        for _ in 0..n {
+            self.clock.tick();
         }
         self.check_states()
     }
@@ -323,9 +477,11 @@ impl VehicleUnit {
 
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
-        let bad = match &self.sprung {
-            Some(b) => b.beyond_bounds(),
-            None => self.vehicle.beyond_bounds(),
+        let bad = match &self.body {
+            Body::RollPlane => self.vehicle.beyond_bounds(),
+            Body::Sprung(b) => b.beyond_bounds(),
+            Body::HalfCar(b) => b.beyond_bounds(),
+            Body::SprungHalfCar(b) => b.beyond_bounds(),
         };
         match bad {
             None => Ok(()),
@@ -335,28 +491,45 @@ impl VehicleUnit {
                 limit,
                 time: self.time(),
                 cause: format!(
-                    "likely contact forces that do not carry the vehicle (contact.left.force = {} N, \
-                     contact.right.force = {} N against a static load of {} N per wheel)",
-                    num(self.force[0]),
-                    num(self.force[1]),
+                    "likely forces that do not carry the vehicle (held forces {} N, {} N \
+                     against a static load of {} N per wheel)",
+                    num(self.force[0][0]),
+                    num(self.force[0][1]),
                     num(self.static_load()[0])
                 ),
             }),
         }
     }
 
+    /// The body's state vector.
+    fn body_state(&self) -> Vec<f64> {
+        match &self.body {
+            Body::RollPlane => self.vehicle.state_vector(),
+            Body::Sprung(b) => b.state_vector(),
+            Body::HalfCar(b) => b.state_vector(),
+            Body::SprungHalfCar(b) => b.state_vector(),
+        }
+    }
+
+    /// Values ahead of the body's in a state vector: the clock (3), then per wheelset
+    /// the held forces (2) and the extremes.
+    fn head_len(&self) -> usize {
+        3 + self.wheelsets() * (2 + ForceExtremes::LEN)
+    }
+
     /// Everything that determines the continuation: the clock (`t0` (s), `k`, the
-    /// carried time (s)), the held forces `[left, right]` (N), the largest and smallest
-    /// forces `[left, right]` (N), then the vehicle's step and displacements;
-    /// [`VehicleUnit::set_state_vector`] restores it exactly.
+    /// carried time (s)), the held forces `[left, right]` (N) of each wheelset, the
+    /// largest and smallest forces `[left, right]` (N) of each, then the vehicle's step
+    /// and displacements; [`VehicleUnit::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let c = &self.clock;
-        let mut v = vec![c.t0, c.k as f64, c.carried, self.force[0], self.force[1]];
-        v.extend(self.extremes.to_array());
-        match &self.sprung {
-            Some(b) => v.extend(b.state_vector()),
-            None => v.extend(self.vehicle.state_vector()),
+        let n = self.wheelsets();
+        let mut v = vec![c.t0, c.k as f64, c.carried];
+        v.extend(self.force[..n].iter().flatten());
+        for e in &self.extremes[..n] {
+            v.extend(e.to_array());
         }
+        v.extend(self.body_state());
         v
     }
 
@@ -367,11 +540,8 @@ impl VehicleUnit {
     /// [`MIN_STEP_FRACTION`]` dt_base ..= dt_base`, and a state beyond the health bounds
     /// ([`VehicleUnit::check_states`]).
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let body_len = match &self.sprung {
-            Some(b) => b.state_vector().len(),
-            None => self.vehicle.state_vector().len(),
-        };
-        let len = HEAD + body_len;
+        let head = self.head_len();
+        let len = head + self.body_state().len();
         if v.len() != len {
             return Err(out_of_range(
                 "vehicle unit state length",
@@ -389,12 +559,12 @@ impl VehicleUnit {
                  below the least step",
             ));
         }
-        for &f in &v[3..HEAD] {
+        for &f in &v[3..head] {
             if !within(f, 1e7) {
                 return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
             }
         }
-        let dt = v[HEAD];
+        let dt = v[head];
         if !(dt >= min_step && dt <= self.clock.base) {
             return Err(out_of_range(
                 "state: step",
@@ -402,21 +572,23 @@ impl VehicleUnit {
                 format!("{} s <= dt <= {} s", num(min_step), num(self.clock.base)),
             ));
         }
-        match &mut self.sprung {
-            Some(b) => {
-                b.set_state_vector(&v[HEAD..])?;
-                self.clock.dt = b.dt();
-            }
-            None => {
-                self.vehicle.set_state_vector(&v[HEAD..])?;
-                self.clock.dt = self.vehicle.dt();
-            }
+        let body = &v[head..];
+        match &mut self.body {
+            Body::RollPlane => self.vehicle.set_state_vector(body)?,
+            Body::Sprung(b) => b.set_state_vector(body)?,
+            Body::HalfCar(b) => b.set_state_vector(body)?,
+            Body::SprungHalfCar(b) => b.set_state_vector(body)?,
         }
+        self.clock.dt = dt;
         self.clock.t0 = v[0];
         self.clock.k = v[1] as u64;
         self.clock.carried = v[2];
-        self.force = [v[3], v[4]];
-        self.extremes = ForceExtremes::from_slice(&v[5..HEAD]);
+        let n = self.wheelsets();
+        for k in 0..n {
+            self.force[k] = [v[3 + 2 * k], v[4 + 2 * k]];
+            let e = 3 + 2 * n + ForceExtremes::LEN * k;
+            self.extremes[k] = ForceExtremes::from_slice(&v[e..e + ForceExtremes::LEN]);
+        }
         self.check_states()
     }
 }

@@ -9,7 +9,8 @@
 //! * [`LumpedTrack`]: the chapter-2 lumped track mass (2.27, second equation), one per rail.
 //!
 //! * [`HalfCarParams`]: the thesis' half-car bogie (figure 1.10), ten degrees of
-//!   freedom, its matrices, natural frequencies and static state.
+//!   freedom, its matrices, natural frequencies and static state; [`HalfCarBogie`]
+//!   and [`SprungHalfCar`] advance it in time, whole or above its primary suspension.
 //! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
 //!   (the primary suspension), for a bogie model that couples at its own step.
 //!
@@ -17,6 +18,7 @@
 
 mod axle_box;
 mod half_car;
+mod half_car_bogie;
 mod lumped;
 mod roll_plane;
 #[cfg(test)]
@@ -26,5 +28,6 @@ pub use axle_box::{PrimaryLink, SprungBogie, WheelsetBody};
 pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
 };
+pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};

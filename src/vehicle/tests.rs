@@ -218,3 +218,115 @@ fn half_car_with_its_wheelsets_moving_alike_is_the_roll_plane_vehicle() {
     }
     assert!(d[3].abs() < 1e-15 && d[5].abs() < 1e-15);
 }
+
+#[test]
+fn half_car_driven_alike_on_both_wheelsets_moves_as_the_roll_plane_vehicle() {
+    // Time domain: the same contact forces on both wheelsets, and the half-car
+    // bogie's bolster, side frames (without pitch) and wheelsets follow the roll-plane
+    // vehicle with the car body's mass on its bolster step by step, to rounding.
+    let mut rp = table_4_4();
+    rp.bolster_mass += rp.carbody_mass;
+    rp.carbody_mass = 0.0;
+    let dt = 2e-5;
+    let h = HalfCarParams::from_roll_plane(&rp, 1.8, 90.0);
+    let mut bogie = HalfCarBogie::new(h, dt).unwrap();
+    let mut roll = RollPlaneVehicle::new(rp, dt).unwrap();
+    let z = [-1.2e-3, -1.4e-3];
+    bogie.set_static([z, z]).unwrap();
+    roll.set_static(z).unwrap();
+    let w = rp.static_wheel_load();
+    let (mut worst, mut motion): (f64, f64) = (0.0, 0.0);
+    let r0 = *roll.displacements();
+    for j in 0..20_000 {
+        // An impact on the left wheel and a slow roll load.
+        let t = j as f64 * dt;
+        let pulse = if (0.01..0.012).contains(&t) {
+            2.0e5
+        } else {
+            0.0
+        };
+        let p = [w + pulse, w - 3e4 * (50.0 * t).sin()];
+        bogie.step([p, p]);
+        roll.step(p);
+        let (b, r) = (bogie.displacements(), roll.displacements());
+        for (x, y) in [
+            (b[0], r[0]),
+            (b[1], r[1]),
+            (b[2], r[2]),
+            (b[4], r[3]),
+            (b[6], r[4]),
+            (b[7], r[5]),
+            (b[8], r[4]),
+            (b[9], r[5]),
+        ] {
+            worst = worst.max((x - y).abs());
+        }
+        motion = motion.max((r - r0).amax());
+        // No pitch: rounding only, which drifts in the free bogie's rigid pitch mode
+        // (side frames pitching with the wheelsets off the rails).
+        assert!(b[3].abs() < 1e-9 && b[5].abs() < 1e-9, "{} {}", b[3], b[5]);
+    }
+    // Off the rails the vehicle moves as a free body under the net force, and the
+    // rounding of two different sums grows with it: agreement to 1e-7 of the motion.
+    assert!(worst < 1e-7 * motion, "{worst} {motion}");
+    // Its bearing forces are the roll-plane vehicle's on each wheelset.
+    let (fb, fr) = (bogie.bearing_forces(), roll.bearing_forces());
+    for k in 0..2 {
+        for s in 0..2 {
+            assert!((fb[k][s] - fr[s]).abs() < 1e-6 * w, "{fb:?} {fr:?}");
+        }
+    }
+}
+
+/// The largest difference (m, rad) between the half-car bogie above its primary
+/// suspension, driven by the whole bogie's primary forces, and the whole bogie, over
+/// 0.1 s at the step `dt` (s), and the largest motion from rest.
+fn sprung_half_car_against_the_whole(dt: f64) -> (f64, f64) {
+    let h = HalfCarParams::from_roll_plane(&table_4_4(), 1.8, 90.0);
+    let mut whole = HalfCarBogie::new(h, dt).unwrap();
+    let mut above = SprungHalfCar::new(h, dt).unwrap();
+    let z = [[-1.2e-3, -1.3e-3], [-1.1e-3, -1.25e-3]];
+    whole.set_static(z).unwrap();
+    let f0 = above.set_static(z).unwrap();
+    let fw = whole.bearing_forces();
+    for k in 0..2 {
+        for s in 0..2 {
+            assert!(
+                (f0[k][s] - fw[k][s]).abs() < 1e-6 * fw[k][s].abs(),
+                "{f0:?} {fw:?}"
+            );
+        }
+    }
+    let w = h.static_wheel_load();
+    let (mut worst, mut motion): (f64, f64) = (0.0, 0.0);
+    let d0 = *whole.displacements();
+    for j in 0..(0.1 / dt).round() as usize {
+        let t = j as f64 * dt;
+        let p = [
+            [w + 1e5 * (300.0 * t).sin(), w],
+            [w, w - 5e4 * (80.0 * t).cos()],
+        ];
+        // The whole bogie's primary forces at t_j drive the part above them.
+        above.step(whole.bearing_forces());
+        whole.step(p);
+        let (a, b) = (above.displacements(), whole.displacements());
+        for i in 0..6 {
+            worst = worst.max((a[i] - b[i]).abs());
+            motion = motion.max((b[i] - d0[i]).abs());
+        }
+    }
+    (worst, motion)
+}
+
+#[test]
+fn half_car_above_its_primary_suspension_converges_to_the_whole() {
+    // Fed the whole bogie's primary forces step by step, the bogie above its primary
+    // suspension follows the whole: not bit for bit, since the whole takes its primary
+    // damping implicitly (3.25) and the cut takes it as a force at t_j; the difference is
+    // of first order in the step and small against the motion.
+    let (e1, m1) = sprung_half_car_against_the_whole(2e-5);
+    let (e2, _) = sprung_half_car_against_the_whole(1e-5);
+    assert!(e1 < 1e-3 * m1, "{e1} {m1}");
+    let order = (e1 / e2).log2();
+    assert!((0.8..1.2).contains(&order), "{e1} {e2} {order}");
+}

@@ -95,6 +95,8 @@ pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
             v[vr::STATIC_WHEEL_Z_RIGHT as usize],
         ],
         axle_box: axle_box(v),
+        half_car: None,
+        trailing_static_wheel_z: [0.0; 2],
     }
 }
 
