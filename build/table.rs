@@ -133,7 +133,20 @@ impl Table {
                     // replaced by the list's item there.
                     let lists: Vec<(String, Vec<String>)> = attrs(&e)
                         .into_iter()
-                        .map(|(k, v)| (k, v.split_whitespace().map(String::from).collect()))
+                        // An item `-` stands for nothing (a name absent from some items).
+                        .map(|(k, v)| {
+                            let items = v
+                                .split_whitespace()
+                                .map(|x| {
+                                    if x == "-" {
+                                        String::new()
+                                    } else {
+                                        x.to_string()
+                                    }
+                                })
+                                .collect();
+                            (k, items)
+                        })
                         .collect();
                     let body_start = reader.buffer_position() as usize;
                     reader.read_to_end(e.name()).expect("closed Repeat");
@@ -211,12 +224,18 @@ fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>) {
             overrides: BTreeMap::new(),
         });
     } else {
+        // `fmu` names one FMU or several, space-separated; overrides of one FMU merge,
+        // the later attribute winning.
         let mut a = attrs(e);
-        let fmu = a.remove("fmu").expect("Override needs fmu=");
-        vars.last_mut()
-            .expect("Override inside a Variable")
-            .overrides
-            .insert(fmu, a);
+        // (An empty list, a Repeat item `-`, overrides nothing.)
+        let fmus = a.remove("fmu").expect("Override needs fmu=");
+        let var = vars.last_mut().expect("Override inside a Variable");
+        for fmu in fmus.split_whitespace() {
+            var.overrides
+                .entry(fmu.to_string())
+                .or_default()
+                .extend(a.clone());
+        }
     }
 }
 

@@ -6,7 +6,12 @@ use crate::table::Table;
 use std::fmt::Write as _;
 
 /// The FMUs in the order of the document's columns.
-const COLUMNS: [&str; 3] = ["TrackContact", "RollPlaneVehicle", "CoupledSystem"];
+const COLUMNS: [&str; 4] = [
+    "TrackContact",
+    "RollPlaneVehicle",
+    "CoupledSystem",
+    "HalfCarBogie",
+];
 
 /// Short name of a causality in the document.
 pub fn causality_abbreviation(causality: &str) -> &'static str {
@@ -28,13 +33,14 @@ pub fn write(table: &Table) -> String {
          three model descriptions and the Rust variable table; do not edit: after a change of the\n\
          table, `cargo run --release --bin build_fmus -- fmu docs/VARIABLES.md` rewrites this\n\
          file, and a unit test fails while it is stale.\n\n\
-         Columns: T = TrackContact, V = RollPlaneVehicle, C = CoupledSystem, with the variable's\n\
+         Columns: T = TrackContact, V = RollPlaneVehicle, C = CoupledSystem, H = HalfCarBogie,\n\
+         with the variable's\n\
          causality in each (par = parameter, calc = calculated parameter, in = input, out =\n\
          output). Units are SI; the display unit is what tools may show. The range is what\n\
          `fmi2SetReal`/`fmi2SetInteger` accept (the physical ranges of `src/limits.rs`); the\n\
          engine checks the rest at `fmi2ExitInitializationMode`.\n\n\
-         | name | T | V | C | type | unit (display) | start | range | description |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+         | name | T | V | C | H | type | unit (display) | start | range | description |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     let fmus: Vec<_> = COLUMNS
         .iter()
@@ -79,11 +85,12 @@ pub fn write(table: &Table) -> String {
         };
         writeln!(
             md,
-            "| `{}` | {} | {} | {} | {ty} | {unit} | {} | {range} | {} |",
+            "| `{}` | {} | {} | {} | {} | {ty} | {unit} | {} | {range} | {} |",
             v.name(),
             cols[0],
             cols[1],
             cols[2],
+            cols[3],
             first("start"),
             v.attrs.get("description").cloned().unwrap_or_default()
         )

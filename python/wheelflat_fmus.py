@@ -283,5 +283,105 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
         vehicle.close()
 
 
+HEIGHTS = ("static_wheel_z.left", "static_wheel_z.right")
+
+
+def half_car_handshake(track, bogie, track_params, bogie_params):
+    """Parameters and the static handshake of TrackContact carrying two wheelsets with
+    the HalfCarBogie: the bogie's static loads to the track, both wheelsets' static
+    wheel heights back; both left in initialization mode. TrackContact's
+    ``wheelset[2].offset`` is set to the bogie's ``vehicle.wheelbase``."""
+    bp = dict(bogie_params or {})
+    tp = dict(track_params or {}, wheelsets=2)
+    for u in (track, bogie):
+        u.fmu.setupExperiment(startTime=0.0)
+    bogie.set_parameters(bp)
+    start = {v.name: v.start for v in bogie.md.modelVariables}
+    tp["wheelset[2].offset"] = float(bp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
+    track.set_parameters(tp)
+    bogie.fmu.enterInitializationMode()
+    track.fmu.enterInitializationMode()
+    loads = ("static_load.left", "static_load.right")
+    track.set(loads, bogie.get(*loads))
+    for names in (HEIGHTS, trailing(2, HEIGHTS)):
+        bogie.set(names, track.get(*names))
+
+
+def run_half_car(paths, stop_time, track_params=None, bogie_params=None, record=None):
+    """Couples TrackContact (two wheelsets) and HalfCarBogie at the contact, at the
+    track's internal step: per communication point both wheelsets' wheel heights and
+    axle rotations to the track, its four contact forces back, both step. This is
+    CoupledSystem with ``vehicle.model`` = half_car, exchanged at every step. Returns
+    the largest contact forces ``[[left, right] of wheelset 1, of wheelset 2]`` (N);
+    ``record``, a list, receives ``[time, the four contact forces]`` at every point."""
+    track = Unit(paths["TrackContact"], "track")
+    bogie = Unit(paths["HalfCarBogie"], "bogie")
+    wheels = WHEELS + trailing(2, WHEELS)
+    forces = FORCES + trailing(2, FORCES)
+    try:
+        half_car_handshake(track, bogie, track_params, bogie_params)
+        track.set(wheels, bogie.get(*wheels))
+        bogie.set(forces, track.get(*forces))
+        bogie.fmu.exitInitializationMode()
+        track.fmu.exitInitializationMode()
+        h = track.get("solver.step")[0]
+        n = int(round(stop_time / h))
+        peak = [[-1e300] * 2, [-1e300] * 2]
+        t = 0.0
+        for k in range(n + 1):
+            track.set(wheels, bogie.get(*wheels))
+            p = track.get(*forces)
+            bogie.set(forces, p)
+            for i in range(4):
+                peak[i // 2][i % 2] = max(peak[i // 2][i % 2], p[i])
+            if record is not None:
+                record.append([t] + p)
+            if k == n:
+                break
+            track.fmu.doStep(t, h)
+            bogie.fmu.doStep(t, h)
+            t = (k + 1) * h
+        return peak
+    finally:
+        track.close()
+        bogie.close()
+
+
+def run_half_car_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, bogie_params=None, record=None):
+    """Couples TrackContact (two wheelsets) and HalfCarBogie at the axle boxes
+    (``interface`` = axle_box): the track carries both wheelsets with their primary
+    suspensions, the bogie the bodies above. Per communication step the side frames'
+    motion above each axle box to the track, the track steps, its mean primary forces
+    back, the bogie steps (track first). Returns the largest contact forces ``[[left,
+    right] of wheelset 1, of wheelset 2]`` (N) over the run; ``record``, a list,
+    receives ``[time, the four contact forces]`` at every communication point."""
+    track = Unit(paths["TrackContact"], "track")
+    bogie = Unit(paths["HalfCarBogie"], "bogie")
+    frames = FRAMES + trailing(2, FRAMES)
+    primary = PRIMARY + trailing(2, PRIMARY)
+    axle_box = AXLE_BOX + trailing(2, AXLE_BOX)
+    forces = FORCES + trailing(2, FORCES)
+    try:
+        half_car_handshake(track, bogie, dict(track_params or {}, interface=2),
+                           dict(bogie_params or {}, interface=2))
+        bogie.fmu.exitInitializationMode()
+        track.fmu.exitInitializationMode()
+        n = int(round(stop_time / comm_step))
+        for k in range(n):
+            t = k * comm_step
+            track.set(frames, bogie.get(*frames))
+            track.fmu.doStep(t, comm_step)
+            bogie.set(axle_box, track.get(*primary))
+            bogie.fmu.doStep(t, comm_step)
+            if record is not None:
+                record.append([t + comm_step] + track.get(*forces))
+        m = track.get("contact.left.max_force", "contact.right.max_force",
+                      *trailing(2, ("contact.left.max_force", "contact.right.max_force")))
+        return [m[:2], m[2:]]
+    finally:
+        track.close()
+        bogie.close()
+
+
 if __name__ == "__main__":
     install_venv()

@@ -291,15 +291,7 @@ impl VehicleUnit {
                 let (d, v) = (self.vehicle.displacements(), self.vehicle.velocities());
                 ([d[2], d[3]], [v[2], v[3]])
             }
-            Body::HalfCar(b) => {
-                let h = b.params();
-                let (d, v) = (b.displacements(), b.velocities());
-                let x = if k == 0 { 0.5 } else { -0.5 } * h.wheelbase;
-                (
-                    [d[2] + x * d[3], d[4] + x * d[5]],
-                    [v[2] + x * v[3], v[4] + x * v[5]],
-                )
-            }
+            Body::HalfCar(b) => b.side_frames_of(k),
             Body::SprungHalfCar(b) => {
                 let (z, v) = b.side_frames();
                 (z[k], v[k])
@@ -309,6 +301,11 @@ impl VehicleUnit {
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
         matches!(self.body, Body::Sprung(_) | Body::SprungHalfCar(_))
+    }
+    /// The held forces `[left, right]` (N) of wheelset `k` (contact, or primary with the
+    /// axle-box interface); `None` for a wheelset the vehicle does not have.
+    pub fn held_forces_of(&self, k: usize) -> Option<[f64; 2]> {
+        (k < self.wheelsets()).then(|| self.force[k])
     }
     /// The held contact forces `[left, right]` (N) of the leading wheelset; with the
     /// axle-box interface the held primary forces.

@@ -158,6 +158,18 @@ impl HalfCarBogie {
         wheels_of(&self.params, self.cd.d())
     }
 
+    /// The side frames' displacements and velocities `[left, right]` (m, m/s) above
+    /// wheelset `k`'s axle boxes (0 leading, 1 trailing; the pitch included), the
+    /// velocities backward differences over the last step.
+    pub fn side_frames_of(&self, k: usize) -> ([f64; 2], [f64; 2]) {
+        let v = self.cd.velocities();
+        let p = &self.params;
+        (
+            p.frames_at_boxes(self.cd.d().as_slice())[k.min(1)],
+            p.frames_at_boxes(v.as_slice())[k.min(1)],
+        )
+    }
+
     /// Primary suspension (bearing) forces at the four axle boxes (N), positive pressing
     /// the wheelsets down: `-(K_1 (z_sf - z_box) + C_1 (v_sf - v_box))`, the side frame
     /// taken at the axle (its pitch included), the velocities backward differences.

@@ -1,4 +1,4 @@
-//! This project's three FMUs over the FMI 2.0 layer: which FMU an instance is
+//! This project's four FMUs over the FMI 2.0 layer: which FMU an instance is
 //! ([`Kind`]), the engine's parameters from its variables, its outputs, and the
 //! [`FmuModel`] that implements [`crate::fmu::fmi2::Model`].
 
@@ -11,7 +11,7 @@ pub use unit::{END_ZONE_SPANS, FmuModel};
 
 use crate::fmu::vars::{self, FmuTable};
 
-/// Which of the three FMUs an instance is.
+/// Which of the four FMUs an instance is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     /// Track and contact, wheels as inputs.
@@ -20,14 +20,17 @@ pub enum Kind {
     RollPlaneVehicle,
     /// The whole model.
     CoupledSystem,
+    /// The half-car bogie, contact (or primary) forces of two wheelsets as inputs.
+    HalfCarBogie,
 }
 
 impl Kind {
-    /// The three FMUs.
-    pub const ALL: [Kind; 3] = [
+    /// The four FMUs.
+    pub const ALL: [Kind; 4] = [
         Kind::TrackContact,
         Kind::RollPlaneVehicle,
         Kind::CoupledSystem,
+        Kind::HalfCarBogie,
     ];
 
     /// The FMU with this GUID.
@@ -41,6 +44,7 @@ impl Kind {
             Kind::TrackContact => &vars::TRACK_CONTACT,
             Kind::RollPlaneVehicle => &vars::ROLL_PLANE_VEHICLE,
             Kind::CoupledSystem => &vars::COUPLED_SYSTEM,
+            Kind::HalfCarBogie => &vars::HALF_CAR_BOGIE,
         }
     }
 }
@@ -48,7 +52,7 @@ impl Kind {
 impl crate::fmu::Instance {
     /// Which FMU this instance is.
     pub fn kind(&self) -> Kind {
-        Kind::from_guid(self.table().guid).expect("an instance of one of the three FMUs")
+        Kind::from_guid(self.table().guid).expect("an instance of one of the four FMUs")
     }
 
     /// The scenario the variables of a track-carrying FMU describe.

@@ -1,4 +1,4 @@
-//! The outputs and calculated parameters of the three FMUs, by value reference.
+//! The outputs and calculated parameters of the four FMUs, by value reference.
 
 use super::FmuModel;
 use super::unit::Engine;
@@ -95,24 +95,59 @@ impl FmuModel {
                 .map_or(f64::NAN, |r| f(&r)),
             View::Vehicle(_) => f64::NAN,
         };
-        // The roll-plane vehicle's displacements and bearing forces, where there is one.
-        let body = |k: usize| match view {
-            View::Vehicle(u) => u.displacements()[k],
-            View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
-                Some(VehicleState::RollPlane(v)) => v.displacements()[k],
-                _ => f64::NAN,
-            },
+        // The half-car bogie's displacements, where there is one (HalfCarBogie, or
+        // CoupledSystem with vehicle.model = half_car).
+        let half_car = match view {
+            View::Vehicle(u) => u.half_car_displacements(),
+            View::Sim(sim, _) => sim.bogie().map(|b| *b.displacements()),
+        };
+        // The roll-plane vehicle's displacements `{z_b, phi_b, z_sfl, z_sfr, z_w,
+        // phi_w}` with the half-car's in their place (the side frames at their centres,
+        // wheelset `index`'s bounce and roll).
+        let body = |k: usize| {
+            if let Some(d) = &half_car {
+                return match k {
+                    0 | 1 => d[k],
+                    2 | 3 => d[2 + 2 * (k - 2)],
+                    _ => d[6 + 2 * index + (k - 4)],
+                };
+            }
+            match view {
+                View::Vehicle(u) => u.displacements()[k],
+                View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                    Some(VehicleState::RollPlane(v)) => v.displacements()[k],
+                    _ => f64::NAN,
+                },
+            }
+        };
+        // The side frames above wheelset `index`'s axle boxes: displacements and
+        // velocities.
+        let frames = || match view {
+            View::Vehicle(u) => u.side_frames_of(index),
+            View::Sim(sim, _) => {
+                match (sim.bogie(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                    (Some(b), _) => Some(b.side_frames_of(index)),
+                    (None, Some(VehicleState::RollPlane(v))) => {
+                        let (d, v) = (v.displacements(), v.velocities());
+                        Some(([d[2], d[3]], [v[2], v[3]]))
+                    }
+                    _ => None,
+                }
+            }
         };
         // The primary forces: the vehicle's, the axle-box interface's mean since the
         // last input, or 0 where the track carries no primary suspension (TrackContact
         // with the contact interface).
         let bearing = || match view {
-            View::Vehicle(u) => u.bearing_forces()[side],
-            View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
-                Some(VehicleState::RollPlane(v)) => v.bearing_forces()[side],
-                Some(VehicleState::AxleBox(link)) => link.mean_force()[side],
-                _ => 0.0,
-            },
+            View::Vehicle(u) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
+            View::Sim(sim, _) => {
+                match (sim.bogie(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                    (Some(b), _) => b.bearing_forces()[index.min(1)][side],
+                    (None, Some(VehicleState::RollPlane(v))) => v.bearing_forces()[side],
+                    (None, Some(VehicleState::AxleBox(link))) => link.mean_force()[side],
+                    _ => 0.0,
+                }
+            }
         };
         let extremes = |sim: &Simulation| {
             sim.wheelsets()
@@ -127,7 +162,7 @@ impl FmuModel {
             Quantity::StaticWheelZ => p.trailing_static_wheel_z[index - 1][side],
             Quantity::ContactKwUsed => p.kw_used,
             Quantity::WheelZ => match view {
-                View::Vehicle(u) => u.wheel_z()[side],
+                View::Vehicle(u) => u.wheel_z_of(index).map_or(0.0, |z| z[side]),
                 View::Sim(_, s) => s.wheel_z[side],
             },
             Quantity::WheelRotation => match view {
@@ -142,11 +177,11 @@ impl FmuModel {
             Quantity::ContactIntervals => contact(|c| c.intervals as f64),
             // The extremes up to the last step, with the force at the current time.
             Quantity::ContactMaxForce => match view {
-                View::Vehicle(u) => u.max_force()[side],
+                View::Vehicle(u) => u.max_force_of(index)[side],
                 View::Sim(sim, s) => extremes(sim).0[side].max(s.contact[side].force),
             },
             Quantity::ContactMinForce => match view {
-                View::Vehicle(u) => u.min_force()[side],
+                View::Vehicle(u) => u.min_force_of(index)[side],
                 View::Sim(sim, s) => extremes(sim).1[side].min(s.contact[side].force),
             },
             Quantity::RailZ => match view {
@@ -159,20 +194,16 @@ impl FmuModel {
                 View::Sim(_, s) => s.position,
                 View::Vehicle(_) => f64::NAN,
             },
-            // `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}`
             Quantity::BolsterZ => body(0),
             Quantity::BolsterRoll => body(1),
-            Quantity::SideframeZ => body(2 + side),
-            Quantity::WheelsetZ => body(4),
-            Quantity::WheelsetRoll => body(5),
+            // Above the axle boxes of wheelset `index` (the half-car's side frames pitch).
+            Quantity::SideframeZ => frames().map_or(f64::NAN, |f| f.0[side]),
+            Quantity::SideframeV => frames().map_or(f64::NAN, |f| f.1[side]),
+            Quantity::SideframePitch => half_car.map_or(0.0, |d| d[3 + 2 * side]),
+            // `wheelset.z`, `.roll` of the leading wheelset, `wheelset[2].z`, `.roll`.
+            Quantity::WheelsetZ | Quantity::Z => body(4),
+            Quantity::WheelsetRoll | Quantity::Roll => body(5),
             Quantity::PrimaryForce => bearing(),
-            Quantity::SideframeV => match view {
-                View::Vehicle(u) => u.side_frames().1[side],
-                View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
-                    Some(VehicleState::RollPlane(v)) => v.velocities()[2 + side],
-                    _ => f64::NAN,
-                },
-            },
             // Observation points: `site_value` above.
             Quantity::SiteRailZ
             | Quantity::SiteRailZMax

@@ -9,7 +9,7 @@ use crate::fmu::vars::{
 use crate::sim::VehicleUnitParams;
 use crate::sim::{Scenario, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
-use crate::vehicle::RollPlaneParams;
+use crate::vehicle::{HalfCarParams, RollPlaneParams};
 use crate::wheel::{FlatShape, FlatSpec};
 
 /// Track parameters (fixed rail ends).
@@ -83,8 +83,20 @@ pub fn wheelset_params(v: &[f64]) -> RollPlaneParams {
     }
 }
 
-/// The vehicle as a co-simulation unit (RollPlaneVehicle).
-pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
+/// The half-car bogie of the roll-plane vehicle's parameters (half a bogie) with the
+/// wheelbase `wheelbase` (m) and the side frames' pitch inertia of the variables.
+fn half_car_params(v: &[f64], wheelbase: f64) -> HalfCarParams {
+    HalfCarParams::from_roll_plane(
+        &vehicle_params(v),
+        wheelbase,
+        v[vr::VEHICLE_SIDEFRAME_PITCH_INERTIA as usize],
+    )
+}
+
+/// The vehicle as a co-simulation unit (RollPlaneVehicle, HalfCarBogie).
+pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
+    let half_car =
+        (kind == Kind::HalfCarBogie).then(|| half_car_params(v, v[vr::VEHICLE_WHEELBASE as usize]));
     VehicleUnitParams {
         vehicle: vehicle_params(v),
         speed: v[vr::SPEED as usize],
@@ -95,8 +107,16 @@ pub fn vehicle_unit_params(v: &[f64]) -> VehicleUnitParams {
             v[vr::STATIC_WHEEL_Z_RIGHT as usize],
         ],
         axle_box: axle_box(v),
-        half_car: None,
-        trailing_static_wheel_z: [0.0; 2],
+        half_car,
+        // Only the half-car bogie has the second wheelset's (the others' values are
+        // not theirs).
+        trailing_static_wheel_z: match half_car {
+            Some(_) => [
+                v[vr::WHEELSET_2_STATIC_WHEEL_Z_LEFT as usize],
+                v[vr::WHEELSET_2_STATIC_WHEEL_Z_RIGHT as usize],
+            ],
+            None => [0.0; 2],
+        },
     }
 }
 
@@ -118,7 +138,8 @@ fn flat(v: &[f64], f: &[u32; 4]) -> FlatSpec {
 }
 
 /// The scenario the variables of a track-carrying FMU describe: CoupledSystem carries
-/// the roll-plane vehicle, TrackContact external wheels with the given static loads.
+/// the roll-plane vehicle or the half-car bogie (its wheelbase `wheelset[2].offset`),
+/// TrackContact external wheels with the given static loads.
 pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
     let val = |r: u32| v[r as usize];
     let flats_of = |vrs: &[[[u32; 4]; 4]; 2]| {
@@ -138,6 +159,9 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         .collect();
     let static_load = [val(vr::STATIC_LOAD_LEFT), val(vr::STATIC_LOAD_RIGHT)];
     let vehicle = match kind {
+        Kind::CoupledSystem if val(vr::VEHICLE_MODEL) == enums::vehicle_model::HALF_CAR => {
+            VehicleSpec::HalfCar(half_car_params(v, val(OFFSET_VRS[0])))
+        }
         Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
         _ if axle_box(v) => VehicleSpec::AxleBox {
             vehicle: wheelset_params(v),

@@ -25,6 +25,24 @@ const FRAME_VRS: [u32; 4] = [
     vr::SIDEFRAME_RIGHT_V,
 ];
 
+/// The vehicle units' contact-force inputs of each wheelset: left, right.
+const VEHICLE_CONTACT_VRS: [[u32; 2]; 2] = [
+    [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
+    [
+        vr::WHEELSET_2_CONTACT_LEFT_FORCE,
+        vr::WHEELSET_2_CONTACT_RIGHT_FORCE,
+    ],
+];
+
+/// The vehicle units' primary-force inputs of each wheelset (`interface = axle_box`).
+const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
+    [vr::AXLE_BOX_LEFT_FORCE, vr::AXLE_BOX_RIGHT_FORCE],
+    [
+        vr::WHEELSET_2_AXLE_BOX_LEFT_FORCE,
+        vr::WHEELSET_2_AXLE_BOX_RIGHT_FORCE,
+    ],
+];
+
 /// The engine behind an FMU.
 #[derive(Debug, Clone)]
 pub(super) enum Engine {
@@ -91,15 +109,21 @@ impl Model for FmuModel {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
         })?;
         let (engine, published) = match kind {
-            Kind::RollPlaneVehicle => {
-                let p = vehicle_unit_params(values);
+            Kind::RollPlaneVehicle | Kind::HalfCarBogie => {
+                let p = vehicle_unit_params(kind, values);
                 let u = VehicleUnit::new(&p)?;
                 let published = Published {
                     static_load: u.static_load(),
                     static_wheel_z: p.static_wheel_z,
-                    trailing_static_wheel_z: [[0.0; 2]; TRAILING],
+                    trailing_static_wheel_z: std::array::from_fn(|k| {
+                        if k == 0 {
+                            p.trailing_static_wheel_z
+                        } else {
+                            [0.0; 2]
+                        }
+                    }),
                     step: u.dt_base(),
-                    critical_step: p.vehicle.critical_time_step(),
+                    critical_step: u.critical_step(),
                     kw_used: 0.0,
                 };
                 (Engine::Vehicle(Box::new(u)), published)
@@ -179,11 +203,16 @@ impl Model for FmuModel {
                 }
                 Ok(())
             }
-            (Engine::Vehicle(u), _) if u.is_axle_box() => {
-                u.set_forces([v(vr::AXLE_BOX_LEFT_FORCE), v(vr::AXLE_BOX_RIGHT_FORCE)])
-            }
             (Engine::Vehicle(u), _) => {
-                u.set_forces([v(vr::CONTACT_LEFT_FORCE), v(vr::CONTACT_RIGHT_FORCE)])
+                let refs = if u.is_axle_box() {
+                    VEHICLE_AXLE_BOX_VRS
+                } else {
+                    VEHICLE_CONTACT_VRS
+                };
+                for (k, [l, r]) in refs.into_iter().take(u.wheelsets()).enumerate() {
+                    u.set_forces_of(k, [v(l), v(r)])?;
+                }
+                Ok(())
             }
         }
     }
@@ -192,13 +221,23 @@ impl Model for FmuModel {
     /// wheelset's wheels, so that an unconnected wheel starts at rest.
     fn input_at_rest(&self, r: u32) -> Option<f64> {
         if let Engine::Vehicle(u) = &self.engine {
-            // The axle-box interface's primary forces at rest.
-            let f = u.bearing_forces();
-            return match r {
-                vr::AXLE_BOX_LEFT_FORCE if u.is_axle_box() => Some(f[0]),
-                vr::AXLE_BOX_RIGHT_FORCE if u.is_axle_box() => Some(f[1]),
-                _ => None,
+            // The held forces at rest: the axle-box interface's primary forces, the
+            // half-car's contact forces (which share its weight by its static state).
+            let refs = match (u.is_axle_box(), u.wheelsets()) {
+                (true, _) => VEHICLE_AXLE_BOX_VRS,
+                (false, 2) => VEHICLE_CONTACT_VRS,
+                (false, _) => return None,
             };
+            for (k, [l, rr]) in refs.into_iter().take(u.wheelsets()).enumerate() {
+                let f = u.held_forces_of(k)?;
+                if r == l {
+                    return Some(f[0]);
+                }
+                if r == rr {
+                    return Some(f[1]);
+                }
+            }
+            return None;
         }
         let sim = self.simulation()?;
         if self.kind != Kind::TrackContact {

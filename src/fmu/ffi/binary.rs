@@ -10,13 +10,9 @@ use std::ffi::c_void;
 /// executable that links the crate).
 pub fn kind_of_binary(path: &str) -> Option<Kind> {
     let stem = std::path::Path::new(path).file_stem()?.to_str()?;
-    [
-        Kind::TrackContact,
-        Kind::RollPlaneVehicle,
-        Kind::CoupledSystem,
-    ]
-    .into_iter()
-    .find(|k| k.table().model_identifier == stem)
+    Kind::ALL
+        .into_iter()
+        .find(|k| k.table().model_identifier == stem)
 }
 
 /// Path of the loaded object that holds this code (the FMU's shared library, or the
@@ -41,7 +37,7 @@ pub fn loaded_binary() -> Option<String> {
 }
 
 /// The FMU a GUID instantiates in a binary of `binary` (see [`kind_of_binary`]): only
-/// its own GUID when the binary is one FMU's, any of the three otherwise.
+/// its own GUID when the binary is one FMU's, any of the four otherwise.
 pub fn kind_for_guid(binary: Option<Kind>, guid: &str) -> Result<Kind, String> {
     let found = Kind::from_guid(guid);
     match (binary, found) {
@@ -61,11 +57,10 @@ pub fn kind_for_guid(binary: Option<Kind>, guid: &str) -> Result<Kind, String> {
             b.table().guid
         )),
         (None, None) => Err(format!(
-            "GUID \"{guid}\" matches none of TrackContact ({}), RollPlaneVehicle ({}), \
-             CoupledSystem ({})",
-            crate::fmu::vars::TRACK_CONTACT.guid,
-            crate::fmu::vars::ROLL_PLANE_VEHICLE.guid,
-            crate::fmu::vars::COUPLED_SYSTEM.guid
+            "GUID \"{guid}\" matches none of {}",
+            Kind::ALL
+                .map(|k| format!("{} ({})", k.table().model_identifier, k.table().guid))
+                .join(", ")
         )),
     }
 }

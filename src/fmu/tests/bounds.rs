@@ -178,11 +178,7 @@ fn contacts_and_suspensions_too_soft_to_carry_the_load_are_refused_at_initialisa
 
 #[test]
 fn a_state_saved_before_the_first_step_restores_in_a_fresh_instance() {
-    for kind in [
-        Kind::TrackContact,
-        Kind::RollPlaneVehicle,
-        Kind::CoupledSystem,
-    ] {
+    for kind in Kind::ALL {
         let (mut a, _) = instance(kind);
         a.enter_initialization().unwrap();
         a.exit_initialization().unwrap();
