@@ -34,7 +34,8 @@ fmi2GetStringStatus""".split()
 
 @pytest.fixture(scope="session")
 def paths():
-    p = {n: os.path.join(wf.FMU_DIR, n + ".fmu") for n in ("TrackContact", "RollPlaneVehicle", "CoupledSystem")}
+    p = {n: os.path.join(wf.FMU_DIR, n + ".fmu")
+         for n in ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")}
     if not all(os.path.exists(x) for x in p.values()):
         p = wf.build_fmus()
     return p
@@ -76,7 +77,7 @@ def initialised(paths, name, log=None, params=None):
 
 # ------------------------------------------------------------------ model descriptions and header
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
 def test_fmpy_validate_reports_nothing(paths, name):
     assert validate_fmu(paths[name]) == []
 
@@ -143,7 +144,7 @@ class HtmlTables(html.parser.HTMLParser):
             self.cell += data
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
 def test_documentation_lists_every_variable_with_its_unit(paths, name):
     from fmpy import read_model_description
     with zipfile.ZipFile(paths[name]) as z:
@@ -502,7 +503,7 @@ def test_wrong_guid_is_refused(paths):
     assert "matches none of" in log.text()
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
 def test_each_fmu_binary_instantiates_only_its_own_guid(paths, name):
     """The three FMUs carry the same library; inside an FMU it is named after the model
     identifier, and takes only that FMU's GUID."""
@@ -570,15 +571,16 @@ def test_reset_then_rerun_gives_identical_results(paths):
     assert max(x[0] for x in a) > 200e3
 
 
-@pytest.mark.parametrize("name", ["CoupledSystem", "TrackContact", "RollPlaneVehicle"])
+@pytest.mark.parametrize("name", ["CoupledSystem", "TrackContact", "RollPlaneVehicle", "HalfCarBogie"])
 def test_state_restore_and_serialisation_continue_bit_identically(paths, name):
     u = initialised(paths, name)
     inputs = {"TrackContact": ("wheel.left.z", -1.3e-3), "RollPlaneVehicle": ("contact.left.force", 150e3),
-              "CoupledSystem": None}[name]
+              "HalfCarBogie": ("wheelset[2].contact.left.force", 150e3), "CoupledSystem": None}[name]
     if inputs:
         u.set([inputs[0]], [inputs[1]])
     outs = {"TrackContact": ("contact.left.force", "rail.left.z"),
             "RollPlaneVehicle": ("wheel.left.z", "bolster.z"),
+            "HalfCarBogie": ("wheelset[2].wheel.left.z", "sideframe.left.pitch"),
             "CoupledSystem": ("contact.left.force", "wheel.right.z")}[name]
     run_for(u, 0.0, 1500, names=outs)  # into the first impact
     t = 1500 * 2e-5
@@ -814,3 +816,62 @@ def test_the_axle_box_interface_starts_at_rest_with_unset_inputs(paths):
     assert t.get("sideframe.left.z")[0] == pytest.approx(v.get("sideframe.left.z")[0], abs=1e-12)
     t.close()
     v.close()
+
+
+# ------------------------------------------------------------------ the half-car bogie (issue 16)
+
+ENDLESS = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
+FOUR_FORCES = wf.FORCES + wf.trailing(2, wf.FORCES)
+
+
+def coupled_half_car(paths, stop_time):
+    """CoupledSystem with the half-car bogie on an endless track: the four contact
+    forces at every internal step."""
+    cs = initialised(paths, "CoupledSystem", params=dict(ENDLESS, **{"vehicle.model": 2, "wheelsets": 2}))
+    h = cs.get("solver.step")[0]
+    out = []
+    for k in range(int(round(stop_time / h)) + 1):
+        out.append(cs.get(*FOUR_FORCES))
+        if k * h >= stop_time - 0.5 * h:
+            break
+        cs.fmu.doStep(k * h, h)
+    cs.close()
+    return np.array(out)
+
+
+def test_half_car_bogie_with_track_contact_at_the_tracks_step_is_coupled_system(paths):
+    # The half-car bogie FMU and TrackContact (two wheelsets, wheelset[2].offset the
+    # wheelbase) exchanged at the track's step do CoupledSystem's arithmetic with
+    # vehicle.model = half_car: the four contact forces agree to 1e-9 (measured: bit
+    # for bit), through the impact of the leading wheelset's flat.
+    ref = coupled_half_car(paths, 0.1)
+    rec = []
+    peak = wf.run_half_car(paths, 0.1, track_params=ENDLESS, record=rec)
+    got = np.array([r[1:] for r in rec])
+    assert got.shape == ref.shape
+    assert np.max(np.abs(got - ref)) <= 1e-9 * np.max(np.abs(ref))
+    assert peak[0][0] > 2.5 * 107.66e3
+
+
+def test_half_car_bogie_at_1_ms_couples_at_the_axle_boxes_within_two_percent(paths):
+    # The bogie exchanging every 1 ms through the axle-box interface: the leading
+    # wheel's peak within 2 % of CoupledSystem's with the half-car bogie, the trailing
+    # wheelset's (which feels the impact through the rails) too.
+    ref = coupled_half_car(paths, 0.1).max(axis=0)
+    peak = wf.run_half_car_axle_box(paths, 0.1, 1e-3, track_params=ENDLESS)
+    assert abs(peak[0][0] / ref[0] - 1) < 0.02, (peak, ref)
+    assert abs(peak[1][0] / ref[2] - 1) < 0.02, (peak, ref)
+
+
+def test_the_half_car_bogie_starts_at_rest_with_unset_inputs(paths):
+    # Unset inputs take the bogie's static forces: stepping it alone for 0.1 s leaves
+    # the bodies where they were (no input set, both interfaces).
+    for interface in (1, 2):
+        b = initialised(paths, "HalfCarBogie", params={"interface": interface})
+        names = ("bolster.z", "sideframe.left.pitch", "wheelset[2].z", "sideframe.left.z")
+        before = b.get(*names)
+        for k in range(100):
+            b.fmu.doStep(k * 1e-3, 1e-3)
+        after = b.get(*names)
+        assert np.max(np.abs(np.array(after) - before)) < 1e-9, (interface, before, after)
+        b.close()

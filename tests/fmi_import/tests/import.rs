@@ -91,3 +91,86 @@ fn track_contact_forces_are_direct_feedthrough() {
     inst.do_step(0.0, 1e-4, true).unwrap();
     inst.terminate().unwrap();
 }
+
+#[test]
+fn half_car_bogie_rests_on_its_static_loads_and_falls_freely_without_them() {
+    let import = fmu("HalfCarBogie");
+    let get = |inst: &mut fmi::fmi2::instance::InstanceCS, names: &[&str]| {
+        let r: Vec<u32> = names.iter().map(|n| vr(&import, n)).collect();
+        let mut v = vec![0.0; r.len()];
+        inst.get_real(&r, &mut v).unwrap();
+        v
+    };
+    // The bogie's mass centre from its outputs: bolster (with half the car body), side
+    // frames (their centres midway between the two axle boxes), wheelsets.
+    let bodies = [
+        "bolster.z",
+        "sideframe.left.z",
+        "wheelset[2].sideframe.left.z",
+        "sideframe.right.z",
+        "wheelset[2].sideframe.right.z",
+        "wheelset.z",
+        "wheelset[2].z",
+    ];
+    let masses = [
+        "vehicle.carbody_mass",
+        "vehicle.bolster.mass",
+        "vehicle.sideframe.mass",
+        "vehicle.wheelset.mass",
+    ];
+    let mut inst = import.instantiate_cs("bogie", false, false).unwrap();
+    inst.setup_experiment(None, 0.0, None).unwrap();
+    inst.enter_initialization_mode().unwrap();
+    inst.exit_initialization_mode().unwrap();
+    let m = get(&mut inst, &masses);
+    // The half-car's masses are twice the roll-plane vehicle's, wheelsets as they are.
+    let (mb, msf, mw) = (2.0 * (m[0] + m[1]), 2.0 * m[2], m[3]);
+    let centre = |z: &[f64]| {
+        (mb * z[0] + msf * (z[1] + z[2] + z[3] + z[4]) / 2.0 + mw * (z[5] + z[6]))
+            / (mb + 2.0 * msf + 2.0 * mw)
+    };
+    let load = get(&mut inst, &["static_load.left"])[0];
+    // Half a bogie's weight per wheel pair of table 4.4: 107.66 kN on each wheel.
+    assert!((load - 107_664.75).abs() < 1.0, "static load {load}");
+    let z0 = get(&mut inst, &bodies);
+    // On its static loads (the unset inputs) it stays at rest for 0.1 s.
+    for k in 0..100 {
+        inst.do_step(k as f64 * 1e-3, 1e-3, true).unwrap();
+    }
+    let z = get(&mut inst, &bodies);
+    for (a, b) in z.iter().zip(&z0) {
+        assert!((a - b).abs() < 1e-9, "{z:?} against {z0:?}");
+    }
+    // Without the contact forces the suspension's forces are internal: the mass
+    // centre falls freely, by g t^2 / 2 = 0.49 mm in 0.01 s; central differences from
+    // rest give exactly g dt^2 n (n + 1) / 2 after n steps.
+    let forces: Vec<u32> = [
+        "contact.left.force",
+        "contact.right.force",
+        "wheelset[2].contact.left.force",
+        "wheelset[2].contact.right.force",
+    ]
+    .iter()
+    .map(|n| vr(&import, n))
+    .collect();
+    inst.set_real(&forces, &[0.0; 4]).unwrap();
+    for k in 0..10 {
+        inst.do_step(0.1 + k as f64 * 1e-3, 1e-3, true).unwrap();
+    }
+    let z = get(&mut inst, &bodies);
+    let fall = centre(&z) - centre(&z0);
+    // Each 1 ms step is cut into equal substeps of at most solver.step.
+    let base = get(&mut inst, &["solver.step"])[0];
+    let per = (1e-3 / base).ceil();
+    let (dt, n) = (1e-3 / per, 10.0 * per);
+    let exact = 9.81 * dt * dt * n * (n + 1.0) / 2.0;
+    assert!(
+        (fall + exact).abs() < 1e-6 * exact,
+        "{fall} against -{exact}"
+    );
+    let drop = 0.5 * 9.81 * 0.01f64.powi(2);
+    assert!((fall + drop).abs() < 0.05 * drop, "{fall} against -{drop}");
+    // The wheelsets, pressed down by their primary springs too, fall much faster.
+    assert!(z[5] - z0[5] < -5.0 * drop, "{z:?}");
+    inst.terminate().unwrap();
+}
