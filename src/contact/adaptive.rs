@@ -99,6 +99,35 @@ fn flatted(
     *out = adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric);
 }
 
+/// The contact stiffness `dP / d delta` (N/m) of the adaptive law, exact: with
+/// `P = K_w * integral of max(0, R(alpha) cos(alpha) - h) d alpha` and `h = R_w -
+/// delta`, the integrand vanishes at every contact edge, so the edges' motion adds
+/// nothing and `dP / d delta = K_w * (the total angle of the compressed springs)`, the
+/// sum of the contact intervals' widths (`2 K_w alpha_w` on a round wheel, from (2.5)).
+/// 0 out of contact. The intervals are found as [`adaptive`] finds them.
+pub fn adaptive_stiffness(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f64) -> f64 {
+    let WheelProfile::Flatted(wheel) = wheel;
+    let rw = wheel.radius();
+    if overlap <= 0.0 || overlap.is_nan() {
+        return 0.0;
+    }
+    let delta = overlap.min(rw);
+    let (aw, _, _) = perfect_patch_scaled(delta * wheel.half_inv_radius());
+    let mut near = [(0.0f64, 0usize); MAX_FLATS];
+    let mut nf = 0;
+    for (i, fl) in wheel.flats().iter().enumerate() {
+        let c = wrap_angle(fl.angle - gamma);
+        if c + fl.half_angle > -aw && c - fl.half_angle < aw {
+            near[nf] = (c, i);
+            nf += 1;
+        }
+    }
+    if nf == 0 {
+        return 2.0 * kw * aw;
+    }
+    kw * adaptive_flats_body(kw, wheel, &near[..nf], overlap, delta, aw, false).1
+}
+
 /// The adaptive integral when flats reach into the patch `[-aw, aw]` (rad) at overlap
 /// `delta` (m) (or always, with `force_numeric`). `near`: those flats, as (centre
 /// space angle, index in the wheel's flats); their windows lie within `pi` of the
@@ -120,11 +149,13 @@ fn adaptive_flats(
 ) -> ContactState {
     SimdLevel::detect().run(
         #[inline(always)]
-        || adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric),
+        || adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric).0,
     )
 }
 
-/// [`adaptive_flats`], inlined into each instruction set's copy.
+/// [`adaptive_flats`], inlined into each instruction set's copy; with the total angle
+/// of the compressed springs (rad), for [`adaptive_stiffness`] (unused, and so
+/// compiled away, in the force's copies).
 #[inline(always)]
 fn adaptive_flats_body(
     kw: f64,
@@ -134,7 +165,7 @@ fn adaptive_flats_body(
     delta: f64,
     aw: f64,
     force_numeric: bool,
-) -> ContactState {
+) -> (ContactState, f64) {
     let rw = wheel.radius();
     let h = rw - delta;
     let flats = wheel.flats();
@@ -335,6 +366,7 @@ fn adaptive_flats_body(
     let mut front = 0.0;
     let mut rear = 0.0;
     let mut intervals = 0u32;
+    let mut measure = 0.0;
     let mut in_contact = false;
     for i in 0..nb - 1 {
         let (a, b) = (brk[i], brk[i + 1]);
@@ -351,6 +383,7 @@ fn adaptive_flats_body(
             } else {
                 gauss(&g_lanes, a, b)
             };
+            measure += b - a;
             if !in_contact {
                 intervals += 1;
                 if intervals == 1 {
@@ -362,19 +395,25 @@ fn adaptive_flats_body(
         in_contact = inside;
     }
     if intervals == 0 {
-        return ContactState {
+        return (
+            ContactState {
+                overlap,
+                ..Default::default()
+            },
+            0.0,
+        );
+    }
+    (
+        ContactState {
+            force: kw * integral,
             overlap,
-            ..Default::default()
-        };
-    }
-    ContactState {
-        force: kw * integral,
-        overlap,
-        front_angle: front,
-        rear_angle: rear,
-        length: h * (front.tan() - rear.tan()),
-        intervals,
-    }
+            front_angle: front,
+            rear_angle: rear,
+            length: h * (front.tan() - rear.tan()),
+            intervals,
+        },
+        measure,
+    )
 }
 
 /// Rounding allowance (m) in the curvature test for slivers: far above the rounding

@@ -9,6 +9,22 @@ use crate::wheel::WheelProfile;
 /// and overlap `overlap` (m); `f_0` is the radius reduction under the wheel centre
 /// (`alpha = 0`). The patch reported is that of the nominal circle pressed in by
 /// `delta_c - f_0` (2.6).
+/// The Hertz law's contact stiffness `dP / d delta = 3/2 C_H d^(1/2)` (N/m), `d` the
+/// overlap less the radius reduction under the wheel centre; 0 out of contact.
+pub(super) fn hertz_stiffness(
+    law: &ContactLaw,
+    wheel: &WheelProfile,
+    gamma: f64,
+    overlap: f64,
+) -> f64 {
+    let d = overlap - wheel.reduction(0.0, gamma);
+    if d > 0.0 {
+        1.5 * law.ch * d.sqrt()
+    } else {
+        0.0
+    }
+}
+
 pub(super) fn hertz(
     law: &ContactLaw,
     wheel: &WheelProfile,

@@ -94,6 +94,19 @@ impl ContactLaw {
         (p(d + e) - p(d - e)) / (2.0 * e)
     }
 
+    /// Contact stiffness `dP / d delta` (N/m) at the overlap `overlap` (m) for a wheel
+    /// with profile `wheel` at axle rotation `gamma` (rad), exact: for the adaptive
+    /// law `K_w` times the total angle of the compressed springs (differentiating
+    /// (2.8): the integrand vanishes at the contact edges), `2 K_w alpha_w` on a round
+    /// wheel; for Hertz `3/2 C_H d^(1/2)` (1.3). 0 out of contact. A wheel moved up by
+    /// `dz` changes the force by `-stiffness * dz`.
+    pub fn stiffness_at(&self, wheel: &WheelProfile, gamma: f64, overlap: f64) -> f64 {
+        match self.model {
+            ContactModel::Adaptive => adaptive::adaptive_stiffness(self.kw, wheel, gamma, overlap),
+            ContactModel::Hertz => hertz::hertz_stiffness(self, wheel, gamma, overlap),
+        }
+    }
+
     /// Contact state for a wheel with profile `wheel` at axle rotation `gamma` (rad)
     /// and overlap `overlap = z_rail - z_wheel` (m) (2.7): for the adaptive law the
     /// integral of the compressed radial springs (2.8; closed form (2.5) where the

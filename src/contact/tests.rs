@@ -272,3 +272,46 @@ fn contact_stiffness_is_the_derivative_of_the_closed_forms() {
     let k = hertz.stiffness(&w, 0.0, 107.7e3);
     assert!((k / (1.5 * 8.5e10 * d.sqrt()) - 1.0).abs() < 1e-6, "{k}");
 }
+
+#[test]
+fn exact_contact_stiffness_is_the_derivative_of_the_force() {
+    // dP/d delta against a central difference of the force (relative step 1e-5), for
+    // a round wheel, split contact (a short flat inside the patch), partial and
+    // asymmetric contact as a long flat passes, and Hertz: within 1e-6.
+    let round = WheelProfile::perfect(R).unwrap();
+    let short = WheelProfile::new(R, &[FlatSpec::haversine(0.008, 0.0003, 0.002)], "f").unwrap();
+    let long = WheelProfile::new(R, &[FlatSpec::haversine(0.1, 0.0015, 0.0)], "f").unwrap();
+    let adaptive = ContactLaw::adaptive(KW).unwrap();
+    let hertz = ContactLaw::hertz(8.6e10).unwrap();
+    let mut checked = 0;
+    for (law, w, gammas) in [
+        (&adaptive, &round, vec![0.0]),
+        (&adaptive, &short, vec![0.0]),
+        (&adaptive, &long, vec![-0.12, -0.08, -0.03, 0.0, 0.05, 0.1]),
+        (&hertz, &round, vec![0.0]),
+        (&hertz, &long, vec![0.0, 0.05]),
+    ] {
+        for gamma in gammas {
+            for delta in [3e-5, 1e-4, 2e-3] {
+                let e = 1e-5 * delta;
+                let p = |x: f64| law.evaluate(w, gamma, x).force;
+                if p(delta - e) <= 0.0 {
+                    // Out of contact (inside a deep flat): no stiffness.
+                    assert_eq!(law.stiffness_at(w, gamma, delta), 0.0);
+                    continue;
+                }
+                let fd = (p(delta + e) - p(delta - e)) / (2.0 * e);
+                let k = law.stiffness_at(w, gamma, delta);
+                assert!(
+                    (k / fd - 1.0).abs() < 1e-6,
+                    "gamma {gamma} delta {delta}: {k} {fd}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 20, "{checked}");
+    // A round wheel: 2 K_w alpha_w (2.5).
+    let aw = patch_angle(1e-4, R);
+    assert!((adaptive.stiffness_at(&round, 0.0, 1e-4) / (2.0 * KW * aw) - 1.0).abs() < 1e-15);
+}
