@@ -39,6 +39,9 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     let fv = &fmu.vars;
     let mut md = String::new();
     let desc = xml_escape(&fmu.attrs["description"]);
+    let interpolate = fmu.capability("canInterpolateInputs", "false");
+    let order = fmu.capability("maxOutputDerivativeOrder", "0");
+    let directional = fmu.capability("providesDirectionalDerivative", "false");
     writeln!(
         md,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription\n  \
@@ -47,11 +50,11 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
          version=\"{version}\"\n  generationTool=\"wheelflat build.rs\"\n  \
          variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"0\">\n  \
          <CoSimulation\n    modelIdentifier=\"{id}\"\n    needsExecutionTool=\"false\"\n    \
-         canHandleVariableCommunicationStepSize=\"true\"\n    canInterpolateInputs=\"false\"\n    \
-         maxOutputDerivativeOrder=\"0\"\n    canRunAsynchronuously=\"false\"\n    \
+         canHandleVariableCommunicationStepSize=\"true\"\n    canInterpolateInputs=\"{interpolate}\"\n    \
+         maxOutputDerivativeOrder=\"{order}\"\n    canRunAsynchronuously=\"false\"\n    \
          canBeInstantiatedOnlyOncePerProcess=\"false\"\n    canNotUseMemoryManagementFunctions=\"true\"\n    \
          canGetAndSetFMUstate=\"true\"\n    canSerializeFMUstate=\"true\"\n    \
-         providesDirectionalDerivative=\"false\"/>"
+         providesDirectionalDerivative=\"{directional}\"/>"
     )
     .unwrap();
     for s in RAW_SECTIONS {

@@ -65,8 +65,14 @@ pub fn write(table: &Table, guids: &[String]) -> String {
              pub static {}: FmuTable = FmuTable {{\n    \
              model_identifier: \"{id}\",\n    guid: \"{g}\",\n    \
              model_description: include_str!(concat!(env!(\"OUT_DIR\"), \"/{id}.xml\")),\n    \
+             can_interpolate_inputs: {},\n    \
+             max_output_derivative_order: {},\n    \
+             provides_directional_derivative: {},\n    \
              vars: &[",
-            split_camel(id, true)
+            split_camel(id, true),
+            fmu.capability("canInterpolateInputs", "false"),
+            fmu.capability("maxOutputDerivativeOrder", "0"),
+            fmu.capability("providesDirectionalDerivative", "false"),
         )
         .unwrap();
         for v in &fmu.vars {

@@ -89,6 +89,12 @@ impl Fmu {
         &self.attrs["modelIdentifier"]
     }
 
+    /// A co-simulation capability of the `<Fmu>` element (`canInterpolateInputs`,
+    /// `maxOutputDerivativeOrder`, `providesDirectionalDerivative`), or `default`.
+    pub fn capability<'a>(&'a self, name: &str, default: &'a str) -> &'a str {
+        self.attrs.get(name).map_or(default, |s| s.as_str())
+    }
+
     /// The resolved attributes of the variable with value reference `vr`, if this FMU
     /// has it.
     pub fn var(&self, vr: usize) -> Option<&FmuVar> {

@@ -55,6 +55,13 @@ pub struct FmuTable {
     pub guid: &'static str,
     /// The modelDescription.xml.
     pub model_description: &'static str,
+    /// `canInterpolateInputs`: `fmi2SetRealInputDerivatives` is supported.
+    pub can_interpolate_inputs: bool,
+    /// `maxOutputDerivativeOrder`: the highest order `fmi2GetRealOutputDerivatives`
+    /// gives (0: not supported).
+    pub max_output_derivative_order: u32,
+    /// `providesDirectionalDerivative`: `fmi2GetDirectionalDerivative` is supported.
+    pub provides_directional_derivative: bool,
     /// Variables in ModelVariables order.
     pub vars: &'static [VarSpec],
 }

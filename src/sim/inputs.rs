@@ -59,7 +59,9 @@ impl Simulation {
     /// [`VehicleSpec::External`](super::VehicleSpec::External) wheels. The axle rotation is not touched: it keeps
     /// turning at `V / R_w` from the last angle given to [`Simulation::set_rotation_of`].
     /// Refused for any other vehicle, a wheelset the simulation does not have, and
-    /// outside `|z| <=` [`crate::limits::DISPLACEMENT_LIMIT`].
+    /// outside `|z| <=` [`crate::limits::DISPLACEMENT_LIMIT`]. Derivatives given at an
+    /// earlier time ([`Simulation::set_wheel_rate_of`]) are dropped: the new heights
+    /// are held; those given at this time stay.
     pub fn set_wheel_z_of(&mut self, k: usize, z: [f64; 2]) -> Result<()> {
         for (name, x) in [("wheel.left.z", z[0]), ("wheel.right.z", z[1])] {
             if !within(x, DISPLACEMENT_LIMIT) {
@@ -73,8 +75,103 @@ impl Simulation {
                 ));
             }
         }
-        if let VehicleState::External { wheel_z, .. } = self.external(k)? {
+        let now = self.time();
+        if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
             *wheel_z = z;
+            if rates.z_since != now {
+                rates.z = [[0.0; 2]; 2];
+                rates.z_since = now;
+            }
+        }
+        self.clear_cache();
+        Ok(())
+    }
+
+    /// Sets the time derivative of order `order` (1 or 2) of wheelset `k`'s wheel
+    /// height on side `side` (0 left, 1 right) at the current time, `value` (m/s or
+    /// m/s^2): from now on the height follows its Taylor polynomial instead of being
+    /// held, until it is set again at a later time ([`Simulation::set_wheel_z_of`]).
+    /// The height it starts from is the one it has now.
+    ///
+    /// Errors: as [`Simulation::set_wheel_z_of`]; an order other than 1 or 2; a value
+    /// not finite or beyond 1e3 m/s (first order) or 1e7 m/s^2 (second).
+    pub fn set_wheel_rate_of(
+        &mut self,
+        k: usize,
+        side: usize,
+        order: usize,
+        value: f64,
+    ) -> Result<()> {
+        let name = if side == 0 {
+            "wheel.left.z"
+        } else {
+            "wheel.right.z"
+        };
+        let limit = match order {
+            1 => 1e3,
+            2 => 1e7,
+            _ => {
+                return Err(out_of_range(
+                    &format!("derivative order of {name}"),
+                    order as f64,
+                    "1 or 2 (the wheel heights follow a polynomial of degree 2 at most)",
+                ));
+            }
+        };
+        if !within(value, limit) {
+            return Err(out_of_range(
+                &format!("d^{order}/dt^{order} {name}"),
+                value,
+                format!("|value| <= {limit} (m/s^{order}), finite"),
+            ));
+        }
+        let now = self.time();
+        if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
+            if rates.z_since != now {
+                *wheel_z = rates.wheel_z_at(*wheel_z, now);
+                rates.z = [[0.0; 2]; 2];
+                rates.z_since = now;
+            }
+            rates.z[order - 1][side.min(1)] = value;
+        }
+        self.clear_cache();
+        Ok(())
+    }
+
+    /// Sets the axle angle's rate `value` (rad/s) of wheelset `k` at the current time:
+    /// from now on the angle turns at it instead of `V / R_w`, until the angle is set
+    /// again at a later time ([`Simulation::set_rotation_of`]).
+    ///
+    /// Errors: as [`Simulation::set_rotation_of`]; a rate not finite or beyond 1e4
+    /// rad/s.
+    pub fn set_rotation_rate_of(&mut self, k: usize, value: f64) -> Result<()> {
+        if !within(value, 1e4) {
+            return Err(out_of_range(
+                "d/dt wheel.rotation",
+                value,
+                "|value| <= 1e4 rad/s, finite",
+            ));
+        }
+        let now = self.time();
+        let rolling = self.motion.speed / self.scenario.wheel_radius;
+        if let VehicleState::External {
+            rotation,
+            since,
+            rates,
+            ..
+        } = self.external(k)?
+        {
+            // The angle now, as it has turned since it was given.
+            let rate = if rates.rotation_given {
+                rates.rotation
+            } else {
+                rolling
+            };
+            *rotation += rate * (now - *since);
+            *since = now;
+            rates.rotation_given = true;
+            rates.rotation_since = now;
+            rates.rotation = value;
         }
         self.clear_cache();
         Ok(())
@@ -89,11 +186,18 @@ impl Simulation {
         finite("wheel.rotation", gamma, "rad")?;
         let now = self.time();
         if let VehicleState::External {
-            rotation, since, ..
+            rotation,
+            since,
+            rates,
+            ..
         } = self.external(k)?
         {
             *rotation = gamma;
             *since = now;
+            if rates.rotation_since != now {
+                rates.rotation_given = false;
+                rates.rotation = 0.0;
+            }
         }
         self.clear_cache();
         Ok(())

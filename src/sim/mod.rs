@@ -21,7 +21,9 @@ pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, TrackWindow,
     TrailingWheelset, VehicleSpec, kmh,
 };
-pub use simulation::{CONTACT_STIFFNESS_MARGIN, Simulation, TrackState, VehicleState, default_dt};
+pub use simulation::{
+    CONTACT_STIFFNESS_MARGIN, InputRates, Simulation, TrackState, VehicleState, default_dt,
+};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};
 pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
 pub use wheelset::{Sample, Wheelset, Wheelsets};

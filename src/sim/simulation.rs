@@ -61,7 +61,71 @@ pub enum VehicleState {
         /// Time (s) at which `rotation` was given; between inputs the axle turns at
         /// `V / R_w`.
         since: f64,
+        /// The inputs' time derivatives, when the master gives them (FMI's
+        /// `fmi2SetRealInputDerivatives`); zero: the inputs are held.
+        rates: InputRates,
     },
+}
+
+/// Time derivatives of a wheelset's external inputs: the wheel heights follow
+/// `z(t) = z + z' tau + z'' tau^2 / 2` and the axle angle `gamma(t) = gamma + gamma'
+/// tau` over the communication step, `tau` from the time they were given, instead of
+/// being held (the heights) or turning at `V / R_w` (the angle).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct InputRates {
+    /// Time (s) the wheel heights' derivatives were given at; the heights extrapolate
+    /// from their value then.
+    pub z_since: f64,
+    /// `[[z' left, z' right] (m/s), [z'' left, z'' right] (m/s^2)]`.
+    pub z: [[f64; 2]; 2],
+    /// Whether the axle angle's rate was given (else it turns at `V / R_w`).
+    pub rotation_given: bool,
+    /// Time (s) the angle's rate was given at.
+    pub rotation_since: f64,
+    /// The axle angle's rate `gamma'` (rad/s).
+    pub rotation: f64,
+}
+
+impl InputRates {
+    /// Values in a state vector.
+    pub(super) const LEN: usize = 8;
+
+    /// Whether the wheel heights move between inputs.
+    #[inline(always)]
+    pub(super) fn moves(&self) -> bool {
+        self.z != [[0.0; 2]; 2]
+    }
+
+    /// The wheel heights (m) at time `t` (s) from `z` given at [`InputRates::z_since`].
+    #[inline]
+    pub(super) fn wheel_z_at(&self, z: [f64; 2], t: f64) -> [f64; 2] {
+        let tau = t - self.z_since;
+        [0, 1].map(|i| z[i] + tau * (self.z[0][i] + 0.5 * tau * self.z[1][i]))
+    }
+
+    pub(super) fn to_array(self) -> [f64; Self::LEN] {
+        let [[a, b], [c, d]] = self.z;
+        [
+            self.z_since,
+            a,
+            b,
+            c,
+            d,
+            f64::from(u8::from(self.rotation_given)),
+            self.rotation_since,
+            self.rotation,
+        ]
+    }
+
+    pub(super) fn from_slice(v: &[f64]) -> InputRates {
+        InputRates {
+            z_since: v[0],
+            z: [[v[1], v[2]], [v[3], v[4]]],
+            rotation_given: v[5] != 0.0,
+            rotation_since: v[6],
+            rotation: v[7],
+        }
+    }
 }
 
 impl VehicleState {
@@ -410,6 +474,7 @@ impl Simulation {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
                     since: 0.0,
+                    rates: InputRates::default(),
                 },
             })
         };
@@ -573,8 +638,18 @@ impl Simulation {
     fn rotation_of(&self, w: &Wheelset) -> f64 {
         match &w.vehicle {
             VehicleState::External {
-                rotation, since, ..
-            } => *rotation + self.motion.speed * (self.time() - since) / self.scenario.wheel_radius,
+                rotation,
+                since,
+                rates,
+                ..
+            } => {
+                if rates.rotation_given {
+                    *rotation + rates.rotation * (self.time() - since)
+                } else {
+                    *rotation
+                        + self.motion.speed * (self.time() - since) / self.scenario.wheel_radius
+                }
+            }
             _ => self.rolling_rotation(),
         }
     }
@@ -603,10 +678,17 @@ impl Simulation {
         let radius = self.scenario.wheel_radius;
         for w in self.wheelsets.iter_mut() {
             if let VehicleState::External {
-                rotation, since, ..
+                rotation,
+                since,
+                rates,
+                ..
             } = &mut w.vehicle
             {
-                *rotation += speed * (now - *since) / radius;
+                if rates.rotation_given {
+                    *rotation += rates.rotation * (now - *since);
+                } else {
+                    *rotation += speed * (now - *since) / radius;
+                }
                 *since = now;
             }
         }
@@ -705,6 +787,11 @@ impl Simulation {
     /// under constant loads).
     #[inline(always)]
     fn wheel_z_of(&self, w: &Wheelset) -> [f64; 2] {
+        if let VehicleState::External { wheel_z, rates, .. } = &w.vehicle
+            && rates.moves()
+        {
+            return rates.wheel_z_at(*wheel_z, self.time());
+        }
         match w.vehicle.wheel_z() {
             Some(z) => z,
             None => self.rail_z_under(w.position(self.position()) - self.origin),

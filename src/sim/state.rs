@@ -2,7 +2,7 @@
 //! that a saved run continues bit for bit (FMU states).
 
 use super::clock::ForceExtremes;
-use super::simulation::{Motion, Simulation, TrackState, VehicleState};
+use super::simulation::{InputRates, Motion, Simulation, TrackState, VehicleState};
 use super::sites::Site;
 use crate::error::{Error, Result, num, out_of_range};
 use crate::limits::MIN_DT_FRACTION;
@@ -61,7 +61,12 @@ impl Simulation {
                 wheel_z,
                 rotation,
                 since,
-            } => vec![wheel_z[0], wheel_z[1], *rotation, *since],
+                rates,
+            } => {
+                let mut v = vec![wheel_z[0], wheel_z[1], *rotation, *since];
+                v.extend(rates.to_array());
+                v
+            }
             VehicleState::AxleBox(link) => link.state_vector(),
             VehicleState::LumpedWheels(_) => return Err(Self::no_state()),
         })
@@ -141,10 +146,19 @@ impl Simulation {
                     wheel_z,
                     rotation,
                     since,
+                    rates,
                 } => {
                     *wheel_z = [e[0], e[1]];
                     *rotation = e[2];
                     *since = e[3];
+                    if !e.iter().all(|x| x.is_finite()) {
+                        return Err(out_of_range(
+                            "state: wheel inputs",
+                            e.iter().copied().find(|x| !x.is_finite()).unwrap_or(0.0),
+                            "finite",
+                        ));
+                    }
+                    *rates = InputRates::from_slice(&e[4..4 + InputRates::LEN]);
                 }
                 _ => {}
             }

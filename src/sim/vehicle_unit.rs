@@ -225,6 +225,28 @@ impl VehicleUnit {
             Body::SprungHalfCar(_) => self.params.trailing_static_wheel_z,
         })
     }
+    /// Wheel-centre velocities `[left, right]` (m/s) of wheelset `k`, backward
+    /// differences over the last step (first order in the step); 0 with the axle-box
+    /// interface (the partner carries the wheelsets); `None` for a wheelset the
+    /// vehicle does not have.
+    pub fn wheel_velocity_of(&self, k: usize) -> Option<[f64; 2]> {
+        if k >= self.wheelsets() {
+            return None;
+        }
+        let h = 0.5 * self.params.vehicle.primary_spacing;
+        let (z, phi) = match &self.body {
+            Body::RollPlane => {
+                let v = self.vehicle.velocities();
+                (v[4], v[5])
+            }
+            Body::HalfCar(b) => {
+                let v = b.velocities();
+                (v[6 + 2 * k], v[7 + 2 * k])
+            }
+            Body::Sprung(_) | Body::SprungHalfCar(_) => (0.0, 0.0),
+        };
+        Some([z - h * phi, z + h * phi])
+    }
     /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad) of the
     /// roll-plane vehicle; with the axle-box interface the wheelset's are its static
     /// ones (the partner carries it). Zero for the half-car bogie

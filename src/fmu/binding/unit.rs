@@ -43,6 +43,37 @@ const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
     ],
 ];
 
+/// The refusal of derivatives of value reference `r`.
+fn no_derivative(r: u32) -> Error {
+    Error::Unsupported(format!(
+        "derivatives of value reference {r}: TrackContact interpolates wheel.*.z (orders 1          and 2) and wheel.rotation (order 1) of each wheelset, with the contact interface;          RollPlaneVehicle and HalfCarBogie give the first derivatives of wheel.*.z,          wheel.rotation and sideframe.*.z"
+    ))
+}
+
+/// The wheelset (0 the leading one) and input (0 left height, 1 right height, 2 axle
+/// angle) of the wheel input (or vehicle output) `r`.
+fn wheel_input(r: u32) -> Option<(usize, usize)> {
+    let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
+    std::iter::once(lead)
+        .chain(TRAILING_INPUT_VRS)
+        .enumerate()
+        .find_map(|(k, refs)| refs.iter().position(|&x| x == r).map(|i| (k, i)))
+}
+
+/// The wheelset, side and whether it is the force (else the overlap) of a contact
+/// output `r` of TrackContact.
+fn contact_output(r: u32) -> Option<(usize, usize, bool)> {
+    use crate::fmu::vars::Quantity;
+    let &Some((q, side, k)) = crate::fmu::vars::QUANTITIES.get(r as usize)? else {
+        return None;
+    };
+    match q {
+        Quantity::ContactForce => Some((k, side, true)),
+        Quantity::ContactOverlap => Some((k, side, false)),
+        _ => None,
+    }
+}
+
 /// The engine behind an FMU.
 #[derive(Debug, Clone)]
 pub(super) enum Engine {
@@ -382,6 +413,115 @@ impl Model for FmuModel {
             Engine::Vehicle(u) => u.set_state_vector(v),
             Engine::Sim(sim) => sim.set_state_vector(v),
         }
+    }
+
+    /// TrackContact (contact interface): the wheel heights' derivatives of order 1 and
+    /// 2, the axle angle's of order 1 (its rate); the inputs of a wheelset the model
+    /// does not have are kept unused.
+    fn set_input_derivative(&mut self, r: u32, order: i32, value: f64) -> Result<(), Error> {
+        let Engine::Sim(sim) = &mut self.engine else {
+            return Err(no_derivative(r));
+        };
+        if self.kind != Kind::TrackContact || matches!(sim.vehicle(), VehicleState::AxleBox(_)) {
+            return Err(no_derivative(r));
+        }
+        let Some((k, which)) = wheel_input(r) else {
+            return Err(no_derivative(r));
+        };
+        if k >= sim.wheelsets().len() {
+            return Ok(());
+        }
+        match which {
+            2 if order == 1 => sim.set_rotation_rate_of(k, value),
+            2 => Err(crate::error::out_of_range(
+                "derivative order of wheel.rotation",
+                order as f64,
+                "1 (the axle angle turns at the rate given)",
+            )),
+            side => sim.set_wheel_rate_of(k, side, order as usize, value),
+        }
+    }
+
+    /// RollPlaneVehicle and HalfCarBogie, first order: the wheel-centre and side-frame
+    /// velocities (backward differences over the last step) and the axle's rate
+    /// `speed / wheel.radius`.
+    fn output_derivative(&self, r: u32, order: i32) -> Result<f64, Error> {
+        let Engine::Vehicle(u) = &self.engine else {
+            return Err(no_derivative(r));
+        };
+        if order != 1 {
+            return Err(no_derivative(r));
+        }
+        if let Some((k, which)) = wheel_input(r) {
+            return match which {
+                2 => Ok(u.params().speed / u.params().wheel_radius),
+                side => u
+                    .wheel_velocity_of(k)
+                    .map(|v| v[side])
+                    .ok_or_else(|| no_derivative(r)),
+            };
+        }
+        let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
+        for (k, [zl, zr, _, _]) in frames.enumerate() {
+            if r == zl || r == zr {
+                let side = usize::from(r == zr);
+                return u
+                    .side_frames_of(k)
+                    .map(|(_, v)| v[side])
+                    .ok_or_else(|| no_derivative(r));
+            }
+        }
+        Err(no_derivative(r))
+    }
+
+    /// TrackContact (contact interface): the contact forces and overlaps of each
+    /// wheelset with respect to its wheel heights, exactly (the contact stiffness
+    /// [`crate::contact::ContactLaw::stiffness_at`]: `dP/dz = -dP/d delta`; `d
+    /// delta/dz = -1`), and the forces with respect to the axle angle (a central
+    /// difference of the law, step 1e-7 rad: a flat turning into the patch); 0
+    /// across wheels and wheelsets.
+    fn partial_derivative(&self, unknown: u32, known: u32) -> Result<f64, Error> {
+        let not = || {
+            Error::Unsupported(format!(
+                "the derivative of value reference {unknown} with respect to {known}:                  TrackContact gives those of contact.*.force and contact.*.overlap (and                  wheelset[k]'s) with respect to wheel.*.z and wheel.rotation, with the                  contact interface"
+            ))
+        };
+        let Engine::Sim(sim) = &self.engine else {
+            return Err(not());
+        };
+        if self.kind != Kind::TrackContact || matches!(sim.vehicle(), VehicleState::AxleBox(_)) {
+            return Err(not());
+        }
+        let (Some((ku, side, force)), Some((kk, which))) =
+            (contact_output(unknown), wheel_input(known))
+        else {
+            return Err(not());
+        };
+        let Some(sample) = sim.sample_of(ku) else {
+            return Ok(0.0);
+        };
+        if ku != kk || (which != 2 && which != side) {
+            return Ok(0.0);
+        }
+        let wheel = &sim
+            .wheelsets()
+            .get(ku)
+            .expect("the sample's wheelset")
+            .wheels()[side];
+        let law = sim.contact_law();
+        let overlap = sample.contact[side].overlap;
+        let gamma = sample.rotation;
+        Ok(match (which, force) {
+            (2, false) => 0.0,
+            (2, true) => {
+                let e = 1e-7;
+                (law.evaluate(wheel, gamma + e, overlap).force
+                    - law.evaluate(wheel, gamma - e, overlap).force)
+                    / (2.0 * e)
+            }
+            (_, true) => -law.stiffness_at(wheel, gamma, overlap),
+            (_, false) => -1.0,
+        })
     }
 
     fn model_time(&self) -> (f64, f64) {

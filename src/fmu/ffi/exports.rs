@@ -498,18 +498,31 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     })
 }
 
-/// `fmi2GetDirectionalDerivative`: not provided (`providesDirectionalDerivative="false"`).
+/// `fmi2GetDirectionalDerivative`: `dvUnknown = J dvKnown`, `J` the partial
+/// derivatives of the outputs `vUnknown_ref` with respect to the inputs `vKnown_ref`
+/// (TrackContact: the exact contact stiffness, `providesDirectionalDerivative="true"`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
-    _vUnknown_ref: *const fmi2ValueReference,
-    _nUnknown: usize,
-    _vKnown_ref: *const fmi2ValueReference,
-    _nKnown: usize,
-    _dvKnown: *const fmi2Real,
-    _dvUnknown: *mut fmi2Real,
+    vUnknown_ref: *const fmi2ValueReference,
+    nUnknown: usize,
+    vKnown_ref: *const fmi2ValueReference,
+    nKnown: usize,
+    dvKnown: *const fmi2Real,
+    dvUnknown: *mut fmi2Real,
 ) -> fmi2Status {
-    unsupported(c, Call::GetDirectionalDerivative)
+    let call = Call::GetDirectionalDerivative;
+    with(c, call, |i| {
+        let unknowns = slice(i, call, "vUnknown_ref", vUnknown_ref, nUnknown)?;
+        let knowns = slice(i, call, "vKnown_ref", vKnown_ref, nKnown)?;
+        let seed = slice(i, call, "dvKnown", dvKnown, nKnown)?;
+        let out = slice_mut(i, call, "dvUnknown", dvUnknown, nUnknown)?;
+        i.get_directional_derivative(unknowns, knowns, seed, out)?;
+        i.log_call(|| {
+            format!("fmi2GetDirectionalDerivative(unknowns={unknowns:?}, knowns={knowns:?}, seed={seed:?}) -> {out:?}")
+        });
+        Ok(())
+    })
 }
 
 /// A function refused in every state: [`Instance::check`] gives the reason from the
@@ -520,28 +533,51 @@ fn unsupported(c: fmi2Component, call: Call) -> fmi2Status {
 
 // ------------------------------------------------------------------ co-simulation
 
-/// `fmi2SetRealInputDerivatives`: not supported (`canInterpolateInputs="false"`).
+/// `fmi2SetRealInputDerivatives`: the inputs' time derivatives at the current
+/// communication point (TrackContact: the wheel heights to order 2, the axle angle to
+/// order 1; `canInterpolateInputs="true"`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     c: fmi2Component,
-    _vr: *const fmi2ValueReference,
-    _nvr: usize,
-    _order: *const fmi2Integer,
-    _value: *const fmi2Real,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *const fmi2Real,
 ) -> fmi2Status {
-    unsupported(c, Call::SetRealInputDerivatives)
+    let call = Call::SetRealInputDerivatives;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let order = slice(i, call, "order", order, nvr)?;
+        let value = slice(i, call, "value", value, nvr)?;
+        i.log_call(|| {
+            format!("fmi2SetRealInputDerivatives(vr={vr:?}, order={order:?}, value={value:?})")
+        });
+        i.set_real_input_derivatives(vr, order, value)
+    })
 }
 
-/// `fmi2GetRealOutputDerivatives`: not supported (`maxOutputDerivativeOrder="0"`).
+/// `fmi2GetRealOutputDerivatives`: the outputs' time derivatives (RollPlaneVehicle and
+/// HalfCarBogie: the wheel and side-frame velocities, the axle's rate;
+/// `maxOutputDerivativeOrder="1"`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     c: fmi2Component,
-    _vr: *const fmi2ValueReference,
-    _nvr: usize,
-    _order: *const fmi2Integer,
-    _value: *mut fmi2Real,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    order: *const fmi2Integer,
+    value: *mut fmi2Real,
 ) -> fmi2Status {
-    unsupported(c, Call::GetRealOutputDerivatives)
+    let call = Call::GetRealOutputDerivatives;
+    with(c, call, |i| {
+        let vr = slice(i, call, "vr", vr, nvr)?;
+        let order = slice(i, call, "order", order, nvr)?;
+        let value = slice_mut(i, call, "value", value, nvr)?;
+        i.get_real_output_derivatives(vr, order, value)?;
+        i.log_call(|| {
+            format!("fmi2GetRealOutputDerivatives(vr={vr:?}, order={order:?}) -> {value:?}")
+        });
+        Ok(())
+    })
 }
 
 /// `fmi2DoStep`.

@@ -137,21 +137,10 @@ pub const CALLS: [(Call, &str, Allowed); 34] = [
     (Call::SerializedFMUstateSize, "fmi2SerializedFMUstateSize", Allowed::In(ALL)),
     (Call::SerializeFMUstate, "fmi2SerializeFMUstate", Allowed::In(ALL)),
     (Call::DeSerializeFMUstate, "fmi2DeSerializeFMUstate", Allowed::In(ALL)),
-    (
-        Call::GetDirectionalDerivative,
-        "fmi2GetDirectionalDerivative",
-        Allowed::Unsupported("providesDirectionalDerivative is false"),
-    ),
-    (
-        Call::SetRealInputDerivatives,
-        "fmi2SetRealInputDerivatives",
-        Allowed::Unsupported("canInterpolateInputs is false; inputs are held over a step"),
-    ),
-    (
-        Call::GetRealOutputDerivatives,
-        "fmi2GetRealOutputDerivatives",
-        Allowed::Unsupported("maxOutputDerivativeOrder is 0"),
-    ),
+    // Where the FMU declares the capability (checked by the instance).
+    (Call::GetDirectionalDerivative, "fmi2GetDirectionalDerivative", Allowed::In(&[Ini, Stc, Stf, Ter, Err_])),
+    (Call::SetRealInputDerivatives, "fmi2SetRealInputDerivatives", Allowed::In(WRITE)),
+    (Call::GetRealOutputDerivatives, "fmi2GetRealOutputDerivatives", Allowed::In(&[Stc, Stf, Ter, Err_])),
     (Call::DoStep, "fmi2DoStep", Allowed::In(&[Stc])),
     (
         Call::CancelStep,

@@ -23,6 +23,9 @@ pub struct Instance<M: Model> {
     /// The inputs the master has set since instantiation or reset, by value reference:
     /// a model is built with these; the others take [`Model::input_at_rest`].
     pub(super) given: Vec<bool>,
+    /// Input derivatives (value reference, order, value) set before the model was
+    /// built: handed to it with the inputs.
+    pub(super) pending_derivatives: Vec<(u32, i32, f64)>,
     /// The calculated parameters of the last model built ([`Model::calculated`]).
     pub(super) calculated: Vec<f64>,
     /// Communication time (s): the master's clock, as its `fmi2DoStep` calls carry it.
@@ -73,6 +76,7 @@ impl<M: Model> Instance<M> {
             model: None,
             dirty: true,
             given: vec![false; N_VR],
+            pending_derivatives: Vec::new(),
             calculated: vec![0.0; M::CALCULATED],
             time: 0.0,
             start_time: 0.0,
@@ -321,6 +325,7 @@ impl<M: Model> Instance<M> {
         self.model = None;
         self.dirty = true;
         self.given.iter_mut().for_each(|g| *g = false);
+        self.pending_derivatives.clear();
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;
@@ -362,6 +367,7 @@ impl<M: Model> Instance<M> {
                         }
                     }
                     self.sync_inputs(&given)?;
+                    self.sync_pending_derivatives()?;
                 }
                 Err(e) => {
                     self.model = None;

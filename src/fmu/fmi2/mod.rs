@@ -4,6 +4,7 @@
 //! [`Model`]. Nothing here knows wheels or tracks.
 
 mod calls;
+mod derivatives;
 mod instance;
 mod model;
 mod states;

@@ -114,4 +114,37 @@ pub trait Model: Clone + Sized {
     /// The model's time since `startTime` (s) and how far it may lie from the
     /// communication time (s): the model steps on its own grid.
     fn model_time(&self) -> (f64, f64);
+
+    /// Sets the time derivative of order `order` (>= 1) of the Real input `vr` at the
+    /// current time (`fmi2SetRealInputDerivatives`; the FMU declares
+    /// `canInterpolateInputs`).
+    ///
+    /// Errors: an input or order the model does not interpolate, a value out of range.
+    fn set_input_derivative(&mut self, vr: u32, _order: i32, _value: f64) -> Result<(), Error> {
+        Err(Error::Unsupported(format!(
+            "input derivatives of value reference {vr}"
+        )))
+    }
+
+    /// The time derivative of order `order` (>= 1) of the output `vr` at the current
+    /// time (`fmi2GetRealOutputDerivatives`, up to the FMU's
+    /// `maxOutputDerivativeOrder`).
+    ///
+    /// Errors: an output the model has no derivative of.
+    fn output_derivative(&self, vr: u32, _order: i32) -> Result<f64, Error> {
+        Err(Error::Unsupported(format!(
+            "output derivatives of value reference {vr}"
+        )))
+    }
+
+    /// The partial derivative of the output `unknown` with respect to the input
+    /// `known` at the current state (`fmi2GetDirectionalDerivative`, where the FMU
+    /// declares `providesDirectionalDerivative`).
+    ///
+    /// Errors: a pair the model has no derivative of.
+    fn partial_derivative(&self, unknown: u32, known: u32) -> Result<f64, Error> {
+        Err(Error::Unsupported(format!(
+            "the derivative of value reference {unknown} with respect to {known}"
+        )))
+    }
 }
