@@ -149,10 +149,15 @@ def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
     track.fmu.exitInitializationMode()
 
 
-def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params=None):
+def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params=None,
+             input_derivatives=False):
     """Couples TrackContact and RollPlaneVehicle; comm_step None takes the track's
-    internal step (``solver.step``), which reproduces CoupledSystem exactly.
-    Returns a dict of lists: time, the TRACK_RECORD outputs and the wheel outputs."""
+    internal step (``solver.step``), which reproduces CoupledSystem exactly. With
+    ``input_derivatives`` the vehicle's wheel velocities and axle rate
+    (``fmi2GetRealOutputDerivatives``) go to the track with the wheel inputs
+    (``fmi2SetRealInputDerivatives``), which then moves the wheels linearly over each
+    step instead of holding them. Returns a dict of lists: time, the TRACK_RECORD
+    outputs and the wheel outputs."""
     track = Unit(paths["TrackContact"], "track")
     vehicle = Unit(paths["RollPlaneVehicle"], "vehicle")
     try:
@@ -161,9 +166,13 @@ def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params
         n = int(round(stop_time / h))
         out = {k: [] for k in ("time",) + TRACK_RECORD + WHEELS}
         t = 0.0
+        wheel_vrs = ([vehicle.vr[w] for w in WHEELS], [track.vr[w] for w in WHEELS])
         for k in range(n + 1):
             z = vehicle.get(*WHEELS)
             track.set(WHEELS, z)
+            if input_derivatives:
+                rates = vehicle.fmu.getRealOutputDerivatives(wheel_vrs[0], [1, 1, 1])
+                track.fmu.setRealInputDerivatives(wheel_vrs[1], [1, 1, 1], list(rates))
             rec = track.get(*TRACK_RECORD)
             vehicle.set(FORCES, rec[:2])
             out["time"].append(t)

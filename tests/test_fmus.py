@@ -875,3 +875,110 @@ def test_the_half_car_bogie_starts_at_rest_with_unset_inputs(paths):
         after = b.get(*names)
         assert np.max(np.abs(np.array(after) - before)) < 1e-9, (interface, before, after)
         b.close()
+
+
+# ------------------------------------------------------------------ derivatives (issue 16)
+
+def test_the_directional_derivative_is_the_contact_stiffness_of_the_law(paths):
+    # fmi2GetDirectionalDerivative of the contact forces with respect to the wheel
+    # heights against a central difference of TrackContact's direct feedthrough, at
+    # rest and as the flat passes the contact (partial contact): within 1e-6.
+    t = initialised(paths, "TrackContact")
+    force = [t.vr[n] for n in ("contact.left.force", "contact.right.force")]
+    z = [t.vr[n] for n in ("wheel.left.z", "wheel.right.z")]
+    checked = []
+    for k in range(2600):
+        if k in (0, 2000, 2080, 2160, 2240):
+            z0 = t.get("wheel.left.z", "wheel.right.z")
+            p0 = t.get("contact.left.force")[0]
+            exact = t.fmu.getDirectionalDerivative(force, [z[0]], [1.0])
+            e = 1e-8
+            t.set(["wheel.left.z"], [z0[0] + e])
+            up = t.get("contact.left.force", "contact.right.force")
+            t.set(["wheel.left.z"], [z0[0] - e])
+            down = t.get("contact.left.force", "contact.right.force")
+            t.set(["wheel.left.z"], [z0[0]])
+            fd = (up[0] - down[0]) / (2 * e)
+            if p0 > 0:
+                assert exact[0] == pytest.approx(fd, rel=1e-6), (k, exact, fd)
+                assert exact[0] < -1e8
+                checked.append(exact[0])
+            assert exact[1] == 0.0 and up[1] == down[1]
+            # Seeds are linear: both wheels at once.
+            both = t.fmu.getDirectionalDerivative(force, z, [2.0, -1.0])
+            right = t.fmu.getDirectionalDerivative([force[1]], [z[1]], [1.0])[0]
+            assert both[0] == pytest.approx(2 * exact[0], rel=1e-15)
+            assert both[1] == pytest.approx(-right, rel=1e-15)
+        t.fmu.doStep(k * 2e-5, 2e-5)
+    # Contact stiffness varies as the flat passes (partial contact is softer).
+    assert len(checked) >= 4 and max(checked) > 1.05 * min(checked), checked
+    t.close()
+
+
+def test_derivatives_are_refused_where_not_declared_and_for_wrong_orders(paths):
+    log = Log()
+    t = wf.Unit(paths["TrackContact"], "t", callbacks=log.callbacks)
+    t.fmu.setupExperiment(startTime=0.0)
+    t.fmu.enterInitializationMode()
+    t.fmu.exitInitializationMode()
+    z = t.vr["wheel.left.z"]
+    with pytest.raises(FMICallException):
+        t.fmu.setRealInputDerivatives([z], [0], [1.0])
+    assert "order 0; allowed: 1 or more" in log.text()
+    with pytest.raises(FMICallException):
+        t.fmu.setRealInputDerivatives([t.vr["wheel.rotation"]], [2], [1.0])
+    assert "derivative order of wheel.rotation" in log.text()
+    with pytest.raises(FMICallException):
+        t.fmu.setRealInputDerivatives([t.vr["contact.left.force"]], [1], [1.0])
+    assert "is not a Real input of TrackContact" in log.text()
+    with pytest.raises(FMICallException):
+        t.fmu.setRealInputDerivatives([z], [1], [float("nan")])
+    with pytest.raises(FMICallException):
+        t.fmu.getRealOutputDerivatives([t.vr["contact.left.force"]], [1])
+    assert "maxOutputDerivativeOrder is 0" in log.text()
+    t.close()
+    v = initialised(paths, "RollPlaneVehicle", log)
+    with pytest.raises(FMICallException):
+        v.fmu.getDirectionalDerivative([v.vr["wheel.left.z"]], [v.vr["contact.left.force"]], [1.0])
+    assert "providesDirectionalDerivative is false" in log.text()
+    with pytest.raises(FMICallException):
+        v.fmu.getRealOutputDerivatives([v.vr["wheel.left.z"]], [2])
+    assert "allowed: 1 to 1" in log.text()
+    v.close()
+
+
+def test_output_derivatives_are_the_vehicles_velocities(paths):
+    # RollPlaneVehicle's wheel velocity after a step of its own base step is the
+    # backward difference over that step; the axle's rate is speed / radius.
+    v = initialised(paths, "RollPlaneVehicle")
+    h = v.get("solver.step")[0]
+    v.set(["contact.left.force"], [150e3])
+    vrs = [v.vr[n] for n in ("wheel.left.z", "wheel.rotation", "sideframe.left.z")]
+    for k in range(20):
+        z0 = v.get("wheel.left.z")[0]
+        v.fmu.doStep(k * h, h)
+        z1 = v.get("wheel.left.z")[0]
+        d = v.fmu.getRealOutputDerivatives(vrs, [1, 1, 1])
+        assert d[0] == pytest.approx((z1 - z0) / h, rel=1e-9, abs=1e-15)
+        assert d[1] == pytest.approx(v.get("speed")[0] / v.get("wheel.radius")[0], rel=1e-15)
+        assert d[2] == v.get("sideframe.left.v")[0]
+    assert d[0] != 0.0
+    v.close()
+
+
+def test_input_derivatives_reduce_the_error_at_five_and_ten_times_the_step(paths):
+    # The pair at 5 and 10 times the track's step, the wheel inputs held or moved
+    # along the vehicle's wheel velocities: the peak error against the track's own
+    # step falls from +5.5 % to +0.7 % (5x) and from +12.2 % to +2.9 % (10x)
+    # (measured; README table).
+    def peak(mult, derivs):
+        h = mult * wf.track_step(paths)
+        out = wf.run_pair(paths, 0.3, h, input_derivatives=derivs)
+        return out["contact.left.max_force"][-1]
+    ref = peak(1, False)
+    assert ref == pytest.approx(306.4e3, rel=1e-3)
+    for mult, held_at_least, ratio in [(5, 0.05, 0.2), (10, 0.10, 0.3)]:
+        held = peak(mult, False) / ref - 1
+        moved = peak(mult, True) / ref - 1
+        assert held > held_at_least, (mult, held)
+        assert abs(moved) < ratio * held, (mult, held, moved)
