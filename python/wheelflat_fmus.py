@@ -18,6 +18,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV = os.path.join(ROOT, ".venv")
 REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
 FMU_DIR = os.path.join(ROOT, "fmu")
+FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")
 # Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
 
@@ -53,7 +54,7 @@ def build_fmus():
     subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "build_fmus"], cwd=ROOT)
     subprocess.check_call([os.path.join(TARGET_DIR, "release", "build_fmus"), FMU_DIR], cwd=ROOT,
                           stdout=subprocess.DEVNULL)
-    return {name: os.path.join(FMU_DIR, name + ".fmu") for name in ("TrackContact", "RollPlaneVehicle", "CoupledSystem")}
+    return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
 
 
 def value_references(model_description):
