@@ -80,6 +80,7 @@ impl Simulation {
             *wheel_z = z;
             if rates.z_since != now {
                 rates.z = [[0.0; 2]; 2];
+                rates.z_given = false;
                 rates.z_since = now;
             }
         }
@@ -133,6 +134,7 @@ impl Simulation {
                 rates.z_since = now;
             }
             rates.z[order - 1][side.min(1)] = value;
+            rates.z_given = true;
         }
         self.clear_cache();
         Ok(())

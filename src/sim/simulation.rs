@@ -78,6 +78,8 @@ pub struct InputRates {
     pub z_since: f64,
     /// `[[z' left, z' right] (m/s), [z'' left, z'' right] (m/s^2)]`.
     pub z: [[f64; 2]; 2],
+    /// Whether any of `z` was given (the wheel heights move between inputs).
+    pub z_given: bool,
     /// Whether the axle angle's rate was given (else it turns at `V / R_w`).
     pub rotation_given: bool,
     /// Time (s) the angle's rate was given at.
@@ -88,12 +90,12 @@ pub struct InputRates {
 
 impl InputRates {
     /// Values in a state vector.
-    pub(super) const LEN: usize = 8;
+    pub(super) const LEN: usize = 9;
 
     /// Whether the wheel heights move between inputs.
     #[inline(always)]
     pub(super) fn moves(&self) -> bool {
-        self.z != [[0.0; 2]; 2]
+        self.z_given
     }
 
     /// The wheel heights (m) at time `t` (s) from `z` given at [`InputRates::z_since`].
@@ -114,6 +116,7 @@ impl InputRates {
             f64::from(u8::from(self.rotation_given)),
             self.rotation_since,
             self.rotation,
+            f64::from(u8::from(self.z_given)),
         ]
     }
 
@@ -124,6 +127,7 @@ impl InputRates {
             rotation_given: v[5] != 0.0,
             rotation_since: v[6],
             rotation: v[7],
+            z_given: v[8] != 0.0,
         }
     }
 }
