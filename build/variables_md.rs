@@ -36,7 +36,9 @@ pub fn write(table: &Table) -> String {
          Columns: T = TrackContact, V = RollPlaneVehicle, C = CoupledSystem, H = HalfCarBogie,\n\
          with the variable's\n\
          causality in each (par = parameter, calc = calculated parameter, in = input, out =\n\
-         output). Units are SI; the display unit is what tools may show. The range is what\n\
+         output). The start value and description are those of the first FMU (in column order)\n\
+         that has the variable; each FMU's `documentation/index.html` gives its own. Units are SI;\n\
+         the display unit is what tools may show. The range is what\n\
          `fmi2SetReal`/`fmi2SetInteger` accept (the physical ranges of `src/limits.rs`); the\n\
          engine checks the rest at `fmi2ExitInitializationMode`.\n\n\
          | name | T | V | C | H | type | unit (display) | start | range | description |\n\

@@ -74,16 +74,7 @@ fn flatted(
     }
     let delta = overlap.min(rw);
     let (aw, sin_minus_x_cos_aw, s2) = perfect_patch_scaled(delta * wheel.half_inv_radius());
-    // Flats whose window (space angles) reaches into [-aw, aw], with their centres.
-    let mut near = [(0.0f64, 0usize); MAX_FLATS];
-    let mut nf = 0;
-    for (i, fl) in wheel.flats().iter().enumerate() {
-        let c = wrap_angle(fl.angle - gamma);
-        if c + fl.half_angle > -aw && c - fl.half_angle < aw {
-            near[nf] = (c, i);
-            nf += 1;
-        }
-    }
+    let (near, nf) = near_flats(wheel, gamma, aw);
     if nf == 0 && !force_numeric {
         // sin(alpha_w) = 2 s sqrt(1 - s^2) with s = sin(alpha_w / 2) = sqrt(delta / 2 R_w).
         *out = ContactState {
@@ -97,6 +88,23 @@ fn flatted(
         return;
     }
     *out = adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric);
+}
+
+/// The flats whose window (space angles) reaches into the patch `[-aw, aw]` (rad) at
+/// axle rotation `gamma` (rad), as (centre space angle, index in the wheel's flats), and
+/// their number.
+#[inline(always)]
+fn near_flats(wheel: &FlattedWheel, gamma: f64, aw: f64) -> ([(f64, usize); MAX_FLATS], usize) {
+    let mut near = [(0.0f64, 0usize); MAX_FLATS];
+    let mut nf = 0;
+    for (i, fl) in wheel.flats().iter().enumerate() {
+        let c = wrap_angle(fl.angle - gamma);
+        if c + fl.half_angle > -aw && c - fl.half_angle < aw {
+            near[nf] = (c, i);
+            nf += 1;
+        }
+    }
+    (near, nf)
 }
 
 /// The contact stiffness `dP / d delta` (N/m) of the adaptive law, exact: with
@@ -113,15 +121,7 @@ pub fn adaptive_stiffness(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f6
     }
     let delta = overlap.min(rw);
     let (aw, _, _) = perfect_patch_scaled(delta * wheel.half_inv_radius());
-    let mut near = [(0.0f64, 0usize); MAX_FLATS];
-    let mut nf = 0;
-    for (i, fl) in wheel.flats().iter().enumerate() {
-        let c = wrap_angle(fl.angle - gamma);
-        if c + fl.half_angle > -aw && c - fl.half_angle < aw {
-            near[nf] = (c, i);
-            nf += 1;
-        }
-    }
+    let (near, nf) = near_flats(wheel, gamma, aw);
     if nf == 0 {
         return 2.0 * kw * aw;
     }

@@ -3,6 +3,7 @@
 //! `[I + dt/2 M^-1 C] x_(j+1) = dt^2 M^-1 f + [2 I - dt^2 M^-1 K] x_j + [dt/2 M^-1 C - I] x_(j-1)`.
 //! The vehicles' bodies use it (`crate::vehicle`).
 
+use crate::error::{Result, out_of_range, positive};
 use nalgebra::{SMatrix, SVector};
 
 /// The state `x_j`, `x_(j-1)` of an `N`-degree-of-freedom system and the update
@@ -110,6 +111,37 @@ impl<const N: usize> CentralDifference<N> {
         let ratio = dt / self.dt;
         self.d_prev = self.d - (self.d - self.d_prev) * ratio;
         self.set_coefficients(dt);
+    }
+
+    /// [`CentralDifference::change_dt`] to `dt` (s) once it is positive and `limit`
+    /// (the caller's stability check) accepts it.
+    ///
+    /// Errors: `dt` not positive (named `solver.dt`), `limit`'s.
+    pub(crate) fn change_dt_checked(&mut self, dt: f64, limit: impl Fn(f64) -> Result<()>) -> Result<()> {
+        positive("solver.dt", dt, "s")?;
+        limit(dt)?;
+        self.change_dt(dt);
+        Ok(())
+    }
+
+    /// Restores [`CentralDifference::state_vector`] `v`, changing the step through
+    /// [`CentralDifference::change_dt_checked`] when it differs.
+    ///
+    /// Errors: a length other than [`CentralDifference::STATE_LEN`] (named `what`), the
+    /// step's refusals.
+    pub(crate) fn restore(&mut self, v: &[f64], what: &str, limit: impl Fn(f64) -> Result<()>) -> Result<()> {
+        if v.len() != Self::STATE_LEN {
+            return Err(out_of_range(
+                what,
+                v.len() as f64,
+                format!("{} values", Self::STATE_LEN),
+            ));
+        }
+        if v[0] != self.dt {
+            self.change_dt_checked(v[0], limit)?;
+        }
+        self.set_displacements_from(v);
+        Ok(())
     }
 
     /// `[dt, x_j (N), x_(j-1) (N)]`.

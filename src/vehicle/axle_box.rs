@@ -367,10 +367,8 @@ impl SprungBogie {
     ///
     /// Errors: `dt` not positive or above the whole vehicle's critical step.
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
-        positive("solver.dt", dt, "s")?;
-        self.params.check_time_step(dt)?;
-        self.cd.change_dt(dt);
-        Ok(())
+        let p = self.params;
+        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))
     }
 
     /// `[dt, d (4), d_prev (4)]`.
@@ -380,19 +378,8 @@ impl SprungBogie {
 
     /// Restores [`SprungBogie::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let len = CentralDifference::<4>::STATE_LEN;
-        if v.len() != len {
-            return Err(out_of_range(
-                "bogie state length",
-                v.len() as f64,
-                format!("{len} values"),
-            ));
-        }
-        if v[0] != self.dt() {
-            self.change_dt(v[0])?;
-        }
-        self.cd.set_displacements_from(v);
-        Ok(())
+        let p = self.params;
+        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// A displacement beyond [`BODY_DISPLACEMENT_LIMIT`], named as the roll-plane

@@ -5,7 +5,7 @@
 //! central differences of the roll-plane vehicle with the damping as in (3.25).
 
 use super::{HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarParams, HalfCarVector};
-use crate::error::{Error, Result, out_of_range, positive};
+use crate::error::{Error, Result, positive};
 use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
 use crate::numerics::CentralDifference;
 use nalgebra::{SMatrix, SVector};
@@ -81,27 +81,6 @@ fn bodies_beyond<const N: usize>(cd: &CentralDifference<N>) -> Option<(&'static 
         .enumerate()
         .map(|(i, &x)| (HALF_CAR_DOF_NAMES[i % N], x, BODY_DISPLACEMENT_LIMIT))
         .find(|&(_, x, l)| !within(x, l))
-}
-
-/// Restores a [`CentralDifference`] state vector `v` through `change_dt`.
-fn restore<const N: usize>(
-    cd: &mut CentralDifference<N>,
-    v: &[f64],
-    change_dt: impl FnOnce(&mut CentralDifference<N>, f64) -> Result<()>,
-) -> Result<()> {
-    let len = CentralDifference::<N>::STATE_LEN;
-    if v.len() != len {
-        return Err(out_of_range(
-            "bogie state length",
-            v.len() as f64,
-            format!("{len} values"),
-        ));
-    }
-    if v[0] != cd.dt() {
-        change_dt(cd, v[0])?;
-    }
-    cd.set_displacements_from(v);
-    Ok(())
 }
 
 /// The half-car bogie in time: ten degrees of freedom ([`HALF_CAR_DOF_NAMES`]) under
@@ -211,10 +190,8 @@ impl HalfCarBogie {
     ///
     /// Errors: `dt` not positive or above the critical step.
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
-        positive("solver.dt", dt, "s")?;
-        self.params.check_time_step(dt)?;
-        self.cd.change_dt(dt);
-        Ok(())
+        let p = self.params;
+        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))
     }
 
     /// `[dt, d (10), d_prev (10)]`.
@@ -224,13 +201,8 @@ impl HalfCarBogie {
 
     /// Restores [`HalfCarBogie::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let params = self.params;
-        restore(&mut self.cd, v, |cd, dt| {
-            positive("solver.dt", dt, "s")?;
-            params.check_time_step(dt)?;
-            cd.change_dt(dt);
-            Ok(())
-        })
+        let p = self.params;
+        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// The first value beyond the health bounds: a body beyond
@@ -343,10 +315,8 @@ impl SprungHalfCar {
 
     /// Changes the step to `dt` (s), as [`HalfCarBogie::change_dt`].
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
-        positive("solver.dt", dt, "s")?;
-        self.params.check_time_step(dt)?;
-        self.cd.change_dt(dt);
-        Ok(())
+        let p = self.params;
+        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))
     }
 
     /// `[dt, d (6), d_prev (6)]`.
@@ -356,13 +326,8 @@ impl SprungHalfCar {
 
     /// Restores [`SprungHalfCar::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let params = self.params;
-        restore(&mut self.cd, v, |cd, dt| {
-            positive("solver.dt", dt, "s")?;
-            params.check_time_step(dt)?;
-            cd.change_dt(dt);
-            Ok(())
-        })
+        let p = self.params;
+        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// A body beyond [`BODY_DISPLACEMENT_LIMIT`].
