@@ -982,3 +982,71 @@ def test_input_derivatives_reduce_the_error_at_five_and_ten_times_the_step(paths
         moved = peak(mult, True) / ref - 1
         assert held > held_at_least, (mult, held)
         assert abs(moved) < ratio * held, (mult, held, moved)
+
+
+def test_input_derivatives_in_initialization_are_checked_kept_and_restored(paths):
+    # Set in initialization mode, derivatives are checked at once (all or none), kept
+    # when a parameter set afterwards rebuilds the model, and an FMU state saved then
+    # continues bit for bit.
+    log = Log()
+    t = wf.Unit(paths["TrackContact"], "t", callbacks=log.callbacks)
+    t.fmu.setupExperiment(startTime=0.0)
+    with pytest.raises(FMICallException):  # not in Instantiated (FMI 2.0 state table)
+        t.fmu.setRealInputDerivatives([t.vr["wheel.left.z"]], [1], [-0.01])
+    t.fmu.enterInitializationMode()
+    z = t.vr["wheel.left.z"]
+    for order, value, said in [(1, float("nan"), "d^1/dt^1 wheel.left.z"), (3, 1.0, "derivative order of wheel.left.z")]:
+        with pytest.raises(FMICallException):
+            t.fmu.setRealInputDerivatives([z], [order], [value])
+        assert said in log.text()
+    # A wheelset the model does not have is checked too.
+    with pytest.raises(FMICallException):
+        t.fmu.setRealInputDerivatives([t.vr["wheelset[2].wheel.left.z"]], [3], [1.0])
+    t.fmu.setRealInputDerivatives([z], [1], [-0.01])
+    t.set(["static_load.left", "static_load.right"], [107664.75, 107664.75])  # rebuilds
+    s = t.fmu.getFMUstate()
+    blob = t.fmu.serializeFMUstate(s)
+    t.fmu.exitInitializationMode()
+    a = run_for(t, 0.0, 100)
+    t.fmu.setFMUstate(s)
+    t.fmu.exitInitializationMode()
+    b = run_for(t, 0.0, 100)
+    u = wf.Unit(paths["TrackContact"], "u")
+    r = u.fmu.deSerializeFMUstate(blob)
+    u.fmu.setFMUstate(r)
+    u.fmu.exitInitializationMode()
+    c = run_for(u, 0.0, 100)
+    plain = initialised(paths, "TrackContact")
+    d = run_for(plain, 0.0, 100)
+    assert a == b == c
+    assert a[-1][0] > d[-1][0] + 1e3  # the wheel moved down 20 um: a larger force (+2.3 kN)
+    for x in (t, u, plain):
+        x.close()
+
+
+def test_setting_one_wheel_leaves_the_other_moving(paths):
+    t = initialised(paths, "TrackContact")
+    t.fmu.setRealInputDerivatives([t.vr["wheel.left.z"]], [1], [-0.002])
+    run_for(t, 0.0, 100)
+    before = t.get("contact.left.force", "contact.left.overlap")
+    t.set(["wheel.right.z"], t.get("wheel.right.z"))
+    after = t.get("contact.left.force", "contact.left.overlap")
+    assert before == after
+    # A seed that overflows is refused, not returned as inf.
+    with pytest.raises(FMICallException):
+        t.fmu.getDirectionalDerivative([t.vr["contact.left.force"]], [t.vr["wheel.left.z"]], [1e308])
+    t.close()
+
+
+def test_a_bogie_step_beyond_the_axle_box_limit_is_warned(paths):
+    log = Log()
+    b = wf.Unit(paths["HalfCarBogie"], "b", callbacks=log.callbacks)
+    b.fmu.setupExperiment(startTime=0.0)
+    b.set_parameters({"interface": 2})
+    b.fmu.enterInitializationMode()
+    b.fmu.exitInitializationMode()
+    b.fmu.doStep(0.0, 1e-3)
+    assert "axle-box interface's exchange" not in log.text()
+    b.fmu.doStep(1e-3, 5e-3)
+    assert "is above about 0.00222" in log.text(), log.text()
+    b.close()

@@ -117,7 +117,11 @@ impl<const N: usize> CentralDifference<N> {
     /// (the caller's stability check) accepts it.
     ///
     /// Errors: `dt` not positive (named `solver.dt`), `limit`'s.
-    pub(crate) fn change_dt_checked(&mut self, dt: f64, limit: impl Fn(f64) -> Result<()>) -> Result<()> {
+    pub(crate) fn change_dt_checked(
+        &mut self,
+        dt: f64,
+        limit: impl Fn(f64) -> Result<()>,
+    ) -> Result<()> {
         positive("solver.dt", dt, "s")?;
         limit(dt)?;
         self.change_dt(dt);
@@ -129,7 +133,12 @@ impl<const N: usize> CentralDifference<N> {
     ///
     /// Errors: a length other than [`CentralDifference::STATE_LEN`] (named `what`), the
     /// step's refusals.
-    pub(crate) fn restore(&mut self, v: &[f64], what: &str, limit: impl Fn(f64) -> Result<()>) -> Result<()> {
+    pub(crate) fn restore(
+        &mut self,
+        v: &[f64],
+        what: &str,
+        limit: impl Fn(f64) -> Result<()>,
+    ) -> Result<()> {
         if v.len() != Self::STATE_LEN {
             return Err(out_of_range(
                 what,

@@ -173,11 +173,28 @@ impl Simulation {
             TrackState::Lumped(_) => "the explicit scheme diverged".into(),
         };
         match self.vehicle() {
-            VehicleState::External { wheel_z, .. } => format!(
-                "likely the wheel inputs (wheel.left.z = {} m, wheel.right.z = {} m) press \
-                 the wheel into the rail far beyond a running wheel's overlap; else {step}",
-                num(wheel_z[0]),
-                num(wheel_z[1])
+            VehicleState::External { rates, .. } => {
+                let z = self.wheel_z();
+                let moved = if rates.moves() {
+                    format!(
+                        ", moved along the input derivatives given at t = {} s and {} s \
+                         ({} m/s, {} m/s)",
+                        rates.z_since[0], rates.z_since[1], rates.z[0][0], rates.z[0][1]
+                    )
+                } else {
+                    String::new()
+                };
+                format!(
+                    "likely the wheel inputs (now wheel.left.z = {} m, wheel.right.z = {} \
+                     m{moved}) put the wheel far from a running wheel's overlap; else {step}",
+                    num(z[0]),
+                    num(z[1])
+                )
+            }
+            VehicleState::AxleBox(_) => format!(
+                "likely the side-frame inputs diverged: a communication step beyond the \
+                 bogie model's stable step (the primary dampers against the side frames); \
+                 else {step}"
             ),
             _ => step,
         }

@@ -77,15 +77,78 @@ impl Simulation {
         }
         let now = self.time();
         if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
-            *wheel_z = z;
-            if rates.z_since != now {
-                rates.z = [[0.0; 2]; 2];
-                rates.z_given = false;
-                rates.z_since = now;
+            for side in 0..2 {
+                Self::give_height(wheel_z, rates, side, z[side], now);
             }
         }
         self.clear_cache();
         Ok(())
+    }
+
+    /// Sets the wheel-centre displacement `z` (m) of one wheel, `side` 0 (left) or 1
+    /// (right), of wheelset `k`, as [`Simulation::set_wheel_z_of`] both; the other
+    /// wheel keeps moving as it was.
+    pub fn set_wheel_side_z_of(&mut self, k: usize, side: usize, z: f64) -> Result<()> {
+        let name = Self::wheel_name(k, side);
+        if !within(z, DISPLACEMENT_LIMIT) {
+            return Err(out_of_range(
+                &name,
+                z,
+                format!("-{DISPLACEMENT_LIMIT} m <= {name} <= {DISPLACEMENT_LIMIT} m"),
+            ));
+        }
+        let now = self.time();
+        if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
+            Self::give_height(wheel_z, rates, side.min(1), z, now);
+        }
+        self.clear_cache();
+        Ok(())
+    }
+
+    /// Takes the input derivatives of each external wheelset from `before`, a
+    /// simulation of the same scenario at the same time (rebuilt after a parameter
+    /// changed): the wheel heights' and the axle angle's rates, from the inputs as they
+    /// are set now.
+    pub fn carry_input_rates_from(&mut self, before: &Simulation) {
+        for (w, b) in self.wheelsets.iter_mut().zip(before.wheelsets.iter()) {
+            if let (
+                VehicleState::External { rates, .. },
+                VehicleState::External { rates: old, .. },
+            ) = (&mut w.vehicle, &b.vehicle)
+            {
+                *rates = *old;
+            }
+        }
+        self.clear_cache();
+    }
+
+    /// The name of wheelset `k`'s wheel height on `side` (0 left, 1 right).
+    fn wheel_name(k: usize, side: usize) -> String {
+        let prefix = if k == 0 {
+            String::new()
+        } else {
+            format!("wheelset[{}].", k + 1)
+        };
+        let s = if side == 0 { "left" } else { "right" };
+        format!("{prefix}wheel.{s}.z")
+    }
+
+    /// One wheel's height `z` (m) given at `now` (s): its derivatives given at an
+    /// earlier time are dropped (the height is held), those given now stay.
+    fn give_height(
+        wheel_z: &mut [f64; 2],
+        rates: &mut super::simulation::InputRates,
+        side: usize,
+        z: f64,
+        now: f64,
+    ) {
+        wheel_z[side] = z;
+        if rates.z_since[side] != now {
+            rates.z[0][side] = 0.0;
+            rates.z[1][side] = 0.0;
+            rates.z_given[side] = false;
+            rates.z_since[side] = now;
+        }
     }
 
     /// Sets the time derivative of order `order` (1 or 2) of wheelset `k`'s wheel
@@ -103,11 +166,25 @@ impl Simulation {
         order: usize,
         value: f64,
     ) -> Result<()> {
-        let name = if side == 0 {
-            "wheel.left.z"
-        } else {
-            "wheel.right.z"
-        };
+        let side = side.min(1);
+        Self::check_wheel_rate(&Self::wheel_name(k, side), order, value)?;
+        let now = self.time();
+        if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
+            if rates.z_since[side] != now {
+                // The height it has now, from which the new derivatives extrapolate.
+                let z = rates.wheel_z_at(*wheel_z, now)[side];
+                Self::give_height(wheel_z, rates, side, z, now);
+            }
+            rates.z[order - 1][side] = value;
+            rates.z_given[side] = true;
+        }
+        self.clear_cache();
+        Ok(())
+    }
+
+    /// Refuses a wheel height's derivative (named `name`) of an order other than 1 or 2,
+    /// or a value not finite or beyond 1e3 m/s (first order) or 1e7 m/s^2 (second).
+    pub fn check_wheel_rate(name: &str, order: usize, value: f64) -> Result<()> {
         let limit = match order {
             1 => 1e3,
             2 => 1e7,
@@ -126,17 +203,26 @@ impl Simulation {
                 format!("|value| <= {limit} (m/s^{order}), finite"),
             ));
         }
-        let now = self.time();
-        if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
-            if rates.z_since != now {
-                *wheel_z = rates.wheel_z_at(*wheel_z, now);
-                rates.z = [[0.0; 2]; 2];
-                rates.z_since = now;
-            }
-            rates.z[order - 1][side.min(1)] = value;
-            rates.z_given = true;
+        Ok(())
+    }
+
+    /// Refuses an axle angle's rate (named `name`) of an order other than 1, or not
+    /// finite or beyond 1e4 rad/s.
+    pub fn check_rotation_rate(name: &str, order: usize, value: f64) -> Result<()> {
+        if order != 1 {
+            return Err(out_of_range(
+                &format!("derivative order of {name}"),
+                order as f64,
+                "1 (the axle angle turns at the rate given)",
+            ));
         }
-        self.clear_cache();
+        if !within(value, 1e4) {
+            return Err(out_of_range(
+                &format!("d/dt {name}"),
+                value,
+                "|value| <= 1e4 rad/s, finite",
+            ));
+        }
         Ok(())
     }
 
@@ -147,13 +233,7 @@ impl Simulation {
     /// Errors: as [`Simulation::set_rotation_of`]; a rate not finite or beyond 1e4
     /// rad/s.
     pub fn set_rotation_rate_of(&mut self, k: usize, value: f64) -> Result<()> {
-        if !within(value, 1e4) {
-            return Err(out_of_range(
-                "d/dt wheel.rotation",
-                value,
-                "|value| <= 1e4 rad/s, finite",
-            ));
-        }
+        Self::check_rotation_rate("wheel.rotation", 1, value)?;
         let now = self.time();
         let rolling = self.motion.speed / self.scenario.wheel_radius;
         if let VehicleState::External {

@@ -320,6 +320,32 @@ impl VehicleUnit {
             }
         })
     }
+    /// The largest communication step (s) at which the axle-box interface's explicit
+    /// exchange of the primary forces stays stable, `2 m / c` of the fastest
+    /// damper-against-body rate: the side frame's mass against its primary dampers,
+    /// and for the half-car bogie its pitch inertia `J` against them, `2 J / (2 C_1
+    /// (a/2)^2)`; measured 4 to 5 ms (roll-plane) and 2 to 2.5 ms (half-car defaults).
+    /// `None` without the axle-box interface or primary damping.
+    pub fn axle_box_step_limit(&self) -> Option<f64> {
+        if !self.is_axle_box() {
+            return None;
+        }
+        let v = &self.params.vehicle;
+        let c1 = v.primary_damping;
+        if c1 <= 0.0 {
+            return None;
+        }
+        Some(match &self.params.half_car {
+            None => 2.0 * v.sideframe_mass / c1,
+            Some(h) => {
+                let half = 0.5 * h.wheelbase;
+                let bounce = 2.0 * h.sideframe_mass / (2.0 * c1);
+                let pitch = 2.0 * h.sideframe_pitch_inertia / (2.0 * c1 * half * half);
+                bounce.min(pitch)
+            }
+        })
+    }
+
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
         matches!(self.body, Body::Sprung(_) | Body::SprungHalfCar(_))
@@ -510,11 +536,37 @@ impl VehicleUnit {
                 limit,
                 time: self.time(),
                 cause: format!(
-                    "likely forces that do not carry the vehicle (held forces {} N, {} N \
-                     against a static load of {} N per wheel)",
-                    num(self.force[0][0]),
-                    num(self.force[0][1]),
-                    num(self.static_load()[0])
+                    "likely forces that do not carry the vehicle (held {}: {} against a \
+                     static load of {} N per wheel){}",
+                    if self.is_axle_box() {
+                        "axle_box.*.force"
+                    } else {
+                        "contact.*.force"
+                    },
+                    (0..self.wheelsets())
+                        .map(|k| {
+                            let prefix = if k == 0 {
+                                String::new()
+                            } else {
+                                format!("wheelset[{}].", k + 1)
+                            };
+                            format!(
+                                "{prefix}left {} N, {prefix}right {} N",
+                                num(self.force[k][0]),
+                                num(self.force[k][1])
+                            )
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    num(self.static_load()[0]),
+                    match self.axle_box_step_limit() {
+                        Some(h) => format!(
+                            "; with the axle-box interface, communication steps above about \
+                             {} s (the primary dampers against the side frames) are unstable",
+                            num(h)
+                        ),
+                        None => String::new(),
+                    }
                 ),
             }),
         }

@@ -379,7 +379,8 @@ impl SprungBogie {
     /// Restores [`SprungBogie::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
         let p = self.params;
-        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
+        self.cd
+            .restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// A displacement beyond [`BODY_DISPLACEMENT_LIMIT`], named as the roll-plane

@@ -120,7 +120,8 @@ impl HalfCarParams {
     }
 
     /// Checks every parameter against its physical range (named as the FMU
-    /// variables); the wheelbase between 0.5 and 5 m, the side frames' pitch inertia
+    /// variables); the wheelbase between 1 and 5 m (more than a wheel's diameter, which
+    /// the track needs between wheelsets), the side frames' pitch inertia
     /// between 1 and 1e5 kg m^2.
     pub fn validate(&self) -> Result<()> {
         for (name, value) in [
@@ -140,7 +141,7 @@ impl HalfCarParams {
             check(name, value)?;
         }
         for (name, v, lo, hi) in [
-            ("vehicle.wheelbase", self.wheelbase, 0.5, 5.0),
+            ("vehicle.wheelbase", self.wheelbase, 1.0, 5.0),
             (
                 "vehicle.sideframe.pitch_inertia",
                 self.sideframe_pitch_inertia,

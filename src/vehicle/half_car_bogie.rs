@@ -202,7 +202,8 @@ impl HalfCarBogie {
     /// Restores [`HalfCarBogie::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
         let p = self.params;
-        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
+        self.cd
+            .restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// The first value beyond the health bounds: a body beyond
@@ -327,7 +328,8 @@ impl SprungHalfCar {
     /// Restores [`SprungHalfCar::state_vector`].
     pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
         let p = self.params;
-        self.cd.restore(v, "bogie state length", |h| p.check_time_step(h))
+        self.cd
+            .restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
     /// A body beyond [`BODY_DISPLACEMENT_LIMIT`].

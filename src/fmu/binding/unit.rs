@@ -46,8 +46,21 @@ const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
 /// The refusal of derivatives of value reference `r`.
 fn no_derivative(r: u32) -> Error {
     Error::Unsupported(format!(
-        "derivatives of value reference {r}: TrackContact interpolates wheel.*.z (orders 1          and 2) and wheel.rotation (order 1) of each wheelset, with the contact interface;          RollPlaneVehicle and HalfCarBogie give the first derivatives of wheel.*.z,          wheel.rotation and sideframe.*.z"
+        "derivatives of `{}`: TrackContact interpolates wheel.*.z (orders 1 and 2) and \
+         wheel.rotation (order 1) of each wheelset, with the contact interface; \
+         RollPlaneVehicle and HalfCarBogie give the first derivatives of wheel.*.z, \
+         wheel.rotation and sideframe.*.z",
+        name_of(r)
     ))
+}
+
+/// The variable name of value reference `r`.
+fn name_of(r: u32) -> String {
+    crate::fmu::vars::FMUS
+        .iter()
+        .flat_map(|t| t.vars.iter())
+        .find(|v| v.vr == r)
+        .map_or_else(|| format!("value reference {r}"), |v| v.name.to_string())
 }
 
 /// The wheelset (0 the leading one) and input (0 left height, 1 right height, 2 axle
@@ -92,6 +105,9 @@ pub struct FmuModel {
     /// The largest force a physical run reaches (N), [`force_limit`] of the static
     /// loads.
     force_limit: f64,
+    /// The last communication step (s), for the vehicles' warning of an axle-box
+    /// exchange beyond its stable step.
+    last_step: f64,
 }
 
 impl FmuModel {
@@ -112,7 +128,15 @@ impl FmuModel {
     #[cold]
     #[inline(never)]
     fn force_fault(&self, spec: &VarSpec, x: f64, time: f64) -> OutputFault {
+        let axle_box = self
+            .simulation()
+            .is_some_and(|s| matches!(s.vehicle(), VehicleState::AxleBox(_)));
         let cause = match self.kind {
+            Kind::TrackContact if axle_box => {
+                "likely the side-frame inputs diverged: a communication step beyond the \
+                 bogie model's stable step (the primary dampers against the side frames), \
+                 or side frames far from the axle boxes"
+            }
             Kind::TrackContact => {
                 "likely the wheel inputs press the wheel into the rail far beyond a running \
                  wheel's overlap"
@@ -183,6 +207,7 @@ impl Model for FmuModel {
             engine,
             force_limit: force_limit(published.static_load),
             published,
+            last_step: 0.0,
         })
     }
 
@@ -216,17 +241,20 @@ impl Model for FmuModel {
                     }
                     return Ok(());
                 }
-                if changed_any(vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z) {
-                    sim.set_wheel_z([v(vr::WHEEL_LEFT_Z), v(vr::WHEEL_RIGHT_Z)])?;
-                }
-                if changed.contains(&vr::WHEEL_ROTATION) {
-                    sim.set_rotation(v(vr::WHEEL_ROTATION))?;
-                }
-                // The wheelsets behind the leading one; the inputs of a wheelset the
-                // model does not have are kept and unused.
-                for (k, &[left, right, rotation]) in (1..n).zip(&TRAILING_INPUT_VRS) {
-                    if changed_any(left, right) {
-                        sim.set_wheel_z_of(k, [v(left), v(right)])?;
+                // The leading wheelset, then those behind it; the inputs of a wheelset
+                // the model does not have are kept and unused. A wheel whose height was
+                // not set keeps moving as it was.
+                let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
+                for (k, &[left, right, rotation]) in std::iter::once(&lead)
+                    .chain(&TRAILING_INPUT_VRS)
+                    .take(n)
+                    .enumerate()
+                {
+                    match (changed.contains(&left), changed.contains(&right)) {
+                        (true, true) => sim.set_wheel_z_of(k, [v(left), v(right)])?,
+                        (true, false) => sim.set_wheel_side_z_of(k, 0, v(left))?,
+                        (false, true) => sim.set_wheel_side_z_of(k, 1, v(right))?,
+                        (false, false) => {}
                     }
                     if changed.contains(&rotation) {
                         sim.set_rotation_of(k, v(rotation))?;
@@ -363,6 +391,7 @@ impl Model for FmuModel {
             }
             Engine::Vehicle(u) => {
                 let plan = u.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                self.last_step = end - (u.time() + u.carried());
                 u.advance_to(plan)?;
             }
         }
@@ -379,8 +408,24 @@ impl Model for FmuModel {
 
     /// When the wheel is within [`END_ZONE_SPANS`] sleeper spans of the fixed rail end,
     /// where the end's reflections raise the impact forces (by 20 to 35 % within the
-    /// last span, table 4.4).
+    /// last span, table 4.4); for the vehicles with the axle-box interface, a
+    /// communication step above [`VehicleUnit::axle_box_step_limit`].
     fn step_warning(&self, time: f64) -> Option<String> {
+        if let Engine::Vehicle(u) = &self.engine {
+            let limit = u.axle_box_step_limit()?;
+            return (self.last_step > limit).then(|| {
+                format!(
+                    "at t = {time} s the communication step {} s is above about {} s, the \
+                     largest at which the axle-box interface's exchange of the primary forces \
+                     stays stable (the primary dampers against the side frames: 2 m / C_1, \
+                     for the half-car bogie 2 J / (2 C_1 (wheelbase/2)^2) with J = \
+                     vehicle.sideframe.pitch_inertia): expect it to diverge; use shorter \
+                     steps",
+                    num(self.last_step),
+                    num(limit)
+                )
+            });
+        }
         let sim = self.simulation()?;
         let TrackSpec::Discrete(p) = &sim.scenario().track else {
             return None;
@@ -428,17 +473,27 @@ impl Model for FmuModel {
         let Some((k, which)) = wheel_input(r) else {
             return Err(no_derivative(r));
         };
+        // Checked whether or not the model has the wheelset.
+        let name = name_of(r);
+        let order = order.max(0) as usize;
+        match which {
+            2 => Simulation::check_rotation_rate(&name, order, value)?,
+            _ => Simulation::check_wheel_rate(&name, order, value)?,
+        }
         if k >= sim.wheelsets().len() {
             return Ok(());
         }
         match which {
-            2 if order == 1 => sim.set_rotation_rate_of(k, value),
-            2 => Err(crate::error::out_of_range(
-                "derivative order of wheel.rotation",
-                order as f64,
-                "1 (the axle angle turns at the rate given)",
-            )),
-            side => sim.set_wheel_rate_of(k, side, order as usize, value),
+            2 => sim.set_rotation_rate_of(k, value),
+            side => sim.set_wheel_rate_of(k, side, order, value),
+        }
+    }
+
+    /// TrackContact: the derivatives the replaced model's wheels had (a parameter set
+    /// after them in initialization mode rebuilt the model).
+    fn carry_inputs_from(&mut self, old: &Self) {
+        if let (Engine::Sim(sim), Engine::Sim(before)) = (&mut self.engine, &old.engine) {
+            sim.carry_input_rates_from(before);
         }
     }
 
@@ -483,7 +538,11 @@ impl Model for FmuModel {
     fn partial_derivative(&self, unknown: u32, known: u32) -> Result<f64, Error> {
         let not = || {
             Error::Unsupported(format!(
-                "the derivative of value reference {unknown} with respect to {known}:                  TrackContact gives those of contact.*.force and contact.*.overlap (and                  wheelset[k]'s) with respect to wheel.*.z and wheel.rotation, with the                  contact interface"
+                "the derivative of `{}` with respect to `{}`: TrackContact gives those of \
+                 contact.*.force and contact.*.overlap (and wheelset[k]'s) with respect to \
+                 wheel.*.z and wheel.rotation, with the contact interface",
+                name_of(unknown),
+                name_of(known)
             ))
         };
         let Engine::Sim(sim) = &self.engine else {

@@ -139,7 +139,7 @@ pub const CALLS: [(Call, &str, Allowed); 34] = [
     (Call::DeSerializeFMUstate, "fmi2DeSerializeFMUstate", Allowed::In(ALL)),
     // Where the FMU declares the capability (checked by the instance).
     (Call::GetDirectionalDerivative, "fmi2GetDirectionalDerivative", Allowed::In(&[Ini, Stc, Stf, Ter, Err_])),
-    (Call::SetRealInputDerivatives, "fmi2SetRealInputDerivatives", Allowed::In(WRITE)),
+    (Call::SetRealInputDerivatives, "fmi2SetRealInputDerivatives", Allowed::In(&[Ini, Stc])),
     (Call::GetRealOutputDerivatives, "fmi2GetRealOutputDerivatives", Allowed::In(&[Stc, Stf, Ter, Err_])),
     (Call::DoStep, "fmi2DoStep", Allowed::In(&[Stc])),
     (

@@ -61,7 +61,8 @@ impl<M: Model> Instance<M> {
     /// `fmi2SetRealInputDerivatives`: the derivatives `values` of orders `orders` of the
     /// inputs `vrs` at the current communication point; they shape the inputs over the
     /// following steps until an input is set again at a later point. All or none are
-    /// taken. Before the model is built they wait for it, as the inputs do.
+    /// taken. In initialization mode the model is built first (as a read builds it), so
+    /// they are checked at once; a parameter set later rebuilds the model with them.
     pub fn set_real_input_derivatives(
         &mut self,
         vrs: &[u32],
@@ -85,15 +86,7 @@ impl<M: Model> Instance<M> {
                 format!("{}: order {o}; allowed: 1 or more", call.name()),
             );
         }
-        if self.model.is_none() || self.dirty {
-            self.pending_derivatives.extend(
-                vrs.iter()
-                    .zip(orders)
-                    .zip(values)
-                    .map(|((&r, &o), &x)| (r, o, x)),
-            );
-            return Ok(());
-        }
+        self.ensure_model()?;
         let saved = self.model.clone();
         for ((&r, &o), &x) in vrs.iter().zip(orders).zip(values) {
             let result = match &mut self.model {
@@ -102,21 +95,6 @@ impl<M: Model> Instance<M> {
             };
             if let Err(e) = result {
                 self.model = saved;
-                return self.model_refusal("input derivatives refused", e);
-            }
-        }
-        Ok(())
-    }
-
-    /// Hands the model the derivatives set before it was built.
-    pub(super) fn sync_pending_derivatives(&mut self) -> FmiResult {
-        let pending = std::mem::take(&mut self.pending_derivatives);
-        for (r, o, x) in pending {
-            let result = match &mut self.model {
-                Some(m) => m.set_input_derivative(r, o, x),
-                None => Ok(()),
-            };
-            if let Err(e) = result {
                 return self.model_refusal("input derivatives refused", e);
             }
         }
@@ -205,6 +183,16 @@ impl<M: Model> Instance<M> {
                     Err(e) => return self.model_refusal("directional derivative", e),
                 }
             }
+        }
+        if let Some(x) = result.iter().find(|x| !x.is_finite()) {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{}: a sensitivity is {x}: the seed times the partial derivatives \
+                     overflows; scale the seed down",
+                    call.name()
+                ),
+            );
         }
         sensitivity[..result.len()].copy_from_slice(&result);
         Ok(())

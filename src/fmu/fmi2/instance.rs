@@ -23,9 +23,6 @@ pub struct Instance<M: Model> {
     /// The inputs the master has set since instantiation or reset, by value reference:
     /// a model is built with these; the others take [`Model::input_at_rest`].
     pub(super) given: Vec<bool>,
-    /// Input derivatives (value reference, order, value) set before the model was
-    /// built: handed to it with the inputs.
-    pub(super) pending_derivatives: Vec<(u32, i32, f64)>,
     /// The calculated parameters of the last model built ([`Model::calculated`]).
     pub(super) calculated: Vec<f64>,
     /// Communication time (s): the master's clock, as its `fmi2DoStep` calls carry it.
@@ -76,7 +73,6 @@ impl<M: Model> Instance<M> {
             model: None,
             dirty: true,
             given: vec![false; N_VR],
-            pending_derivatives: Vec::new(),
             calculated: vec![0.0; M::CALCULATED],
             time: 0.0,
             start_time: 0.0,
@@ -325,7 +321,6 @@ impl<M: Model> Instance<M> {
         self.model = None;
         self.dirty = true;
         self.given.iter_mut().for_each(|g| *g = false);
-        self.pending_derivatives.clear();
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;
@@ -349,6 +344,7 @@ impl<M: Model> Instance<M> {
     /// current inputs.
     pub(super) fn ensure_model(&mut self) -> FmiResult {
         if self.model.is_none() || self.dirty {
+            let old = self.model.take();
             match M::build(self.table, &self.values) {
                 Ok(m) => {
                     self.calculated = m.calculated();
@@ -367,7 +363,9 @@ impl<M: Model> Instance<M> {
                         }
                     }
                     self.sync_inputs(&given)?;
-                    self.sync_pending_derivatives()?;
+                    if let (Some(m), Some(old)) = (&mut self.model, &old) {
+                        m.carry_inputs_from(old);
+                    }
                 }
                 Err(e) => {
                     self.model = None;

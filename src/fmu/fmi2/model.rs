@@ -115,6 +115,11 @@ pub trait Model: Clone + Sized {
     /// communication time (s): the model steps on its own grid.
     fn model_time(&self) -> (f64, f64);
 
+    /// Takes over from `old`, the model this one replaces after a parameter changed
+    /// (in initialization mode), what the master gave it besides the values the layer
+    /// keeps: the inputs' derivatives. Called after the inputs are handed over.
+    fn carry_inputs_from(&mut self, _old: &Self) {}
+
     /// Sets the time derivative of order `order` (>= 1) of the Real input `vr` at the
     /// current time (`fmi2SetRealInputDerivatives`; the FMU declares
     /// `canInterpolateInputs`).
