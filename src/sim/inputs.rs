@@ -77,8 +77,12 @@ impl Simulation {
         }
         let now = self.time();
         if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
-            for side in 0..2 {
-                Self::give_height(wheel_z, rates, side, z[side], now);
+            if rates.moves() {
+                for side in 0..2 {
+                    Self::give_height(wheel_z, rates, side, z[side], now);
+                }
+            } else {
+                *wheel_z = z;
             }
         }
         self.clear_cache();
@@ -143,7 +147,9 @@ impl Simulation {
         now: f64,
     ) {
         wheel_z[side] = z;
-        if rates.z_since[side] != now {
+        // Without derivatives the time a height was given does not matter (derivatives
+        // given later at the same time extrapolate from the height then, which is it).
+        if rates.z_given[side] && rates.z_since[side] != now {
             rates.z[0][side] = 0.0;
             rates.z[1][side] = 0.0;
             rates.z_given[side] = false;

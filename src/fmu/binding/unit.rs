@@ -43,6 +43,29 @@ const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
     ],
 ];
 
+/// Hands wheelset `k` of `sim` its wheel inputs `[left z, right z, rotation]` (value
+/// references) among `changed`, from `values`.
+#[inline(always)]
+fn wheel_inputs(
+    sim: &mut Simulation,
+    k: usize,
+    [left, right, rotation]: [u32; 3],
+    values: &[f64],
+    changed: &[u32],
+) -> Result<(), Error> {
+    let v = |r: u32| values[r as usize];
+    match (changed.contains(&left), changed.contains(&right)) {
+        (true, true) => sim.set_wheel_z_of(k, [v(left), v(right)])?,
+        (true, false) => sim.set_wheel_side_z_of(k, 0, v(left))?,
+        (false, true) => sim.set_wheel_side_z_of(k, 1, v(right))?,
+        (false, false) => {}
+    }
+    if changed.contains(&rotation) {
+        sim.set_rotation_of(k, v(rotation))?;
+    }
+    Ok(())
+}
+
 /// The refusal of derivatives of value reference `r`.
 fn no_derivative(r: u32) -> Error {
     Error::Unsupported(format!(
@@ -245,20 +268,9 @@ impl Model for FmuModel {
                 // the model does not have are kept and unused. A wheel whose height was
                 // not set keeps moving as it was.
                 let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
-                for (k, &[left, right, rotation]) in std::iter::once(&lead)
-                    .chain(&TRAILING_INPUT_VRS)
-                    .take(n)
-                    .enumerate()
-                {
-                    match (changed.contains(&left), changed.contains(&right)) {
-                        (true, true) => sim.set_wheel_z_of(k, [v(left), v(right)])?,
-                        (true, false) => sim.set_wheel_side_z_of(k, 0, v(left))?,
-                        (false, true) => sim.set_wheel_side_z_of(k, 1, v(right))?,
-                        (false, false) => {}
-                    }
-                    if changed.contains(&rotation) {
-                        sim.set_rotation_of(k, v(rotation))?;
-                    }
+                wheel_inputs(sim, 0, lead, values, changed)?;
+                for (k, &refs) in (1..n).zip(&TRAILING_INPUT_VRS) {
+                    wheel_inputs(sim, k, refs, values, changed)?;
                 }
                 Ok(())
             }
