@@ -6,6 +6,21 @@
 use crate::error::{Result, out_of_range, positive};
 use nalgebra::{SMatrix, SVector};
 
+/// Refuses a step `dt` (s) above the `critical` step (s) of central differences on a
+/// system's fastest mode (`2 / omega_max`), `what` naming the system.
+pub(crate) fn check_critical_step(dt: f64, critical: f64, what: &str) -> Result<()> {
+    if dt > critical {
+        return Err(crate::error::Error::UnstableTimeStep {
+            dt,
+            critical,
+            limit: format!(
+                "{what}: central differences on the fastest suspension mode (2 / omega_max)"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// The state `x_j`, `x_(j-1)` of an `N`-degree-of-freedom system and the update
 /// matrices of its step `dt` (s).
 #[derive(Debug, Clone)]

@@ -11,7 +11,7 @@ mod simd;
 mod small_angle;
 
 pub(crate) use banded::solve_banded_spd;
-pub(crate) use central_difference::CentralDifference;
+pub(crate) use central_difference::{CentralDifference, check_critical_step};
 pub(crate) use quadrature::gauss_legendre;
 pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};

@@ -32,17 +32,7 @@ impl HalfCarParams {
 
     /// Refuses a step above [`HalfCarParams::critical_time_step`].
     pub fn check_time_step(&self, dt: f64) -> Result<()> {
-        let critical = self.critical_time_step();
-        if dt > critical {
-            return Err(Error::UnstableTimeStep {
-                dt,
-                critical,
-                limit: "half-car bogie: central differences on the fastest suspension mode \
-                        (2 / omega_max)"
-                    .into(),
-            });
-        }
-        Ok(())
+        crate::numerics::check_critical_step(dt, self.critical_time_step(), "half-car bogie")
     }
 
     /// Where wheelset `i` (0 leading, 1 trailing) lies along the track from the bogie's

@@ -170,17 +170,7 @@ impl RollPlaneParams {
 
     /// Refuses a step above [`RollPlaneParams::critical_time_step`].
     pub fn check_time_step(&self, dt: f64) -> Result<()> {
-        let critical = self.critical_time_step();
-        if dt > critical {
-            return Err(Error::UnstableTimeStep {
-                dt,
-                critical,
-                limit:
-                    "vehicle: central differences on the fastest suspension mode (2 / omega_max)"
-                        .into(),
-            });
-        }
-        Ok(())
+        crate::numerics::check_critical_step(dt, self.critical_time_step(), "vehicle")
     }
 
     /// Default step for the vehicle on its own (s): 50 steps per shortest natural
