@@ -513,6 +513,7 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
 ) -> fmi2Status {
     let call = Call::GetDirectionalDerivative;
     with(c, call, |i| {
+        i.check_declared(call)?;
         let unknowns = slice(i, call, "vUnknown_ref", vUnknown_ref, nUnknown)?;
         let knowns = slice(i, call, "vKnown_ref", vKnown_ref, nKnown)?;
         let seed = slice(i, call, "dvKnown", dvKnown, nKnown)?;
@@ -546,6 +547,7 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
 ) -> fmi2Status {
     let call = Call::SetRealInputDerivatives;
     with(c, call, |i| {
+        i.check_declared(call)?;
         let vr = slice(i, call, "vr", vr, nvr)?;
         let order = slice(i, call, "order", order, nvr)?;
         let value = slice(i, call, "value", value, nvr)?;
@@ -569,6 +571,7 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
 ) -> fmi2Status {
     let call = Call::GetRealOutputDerivatives;
     with(c, call, |i| {
+        i.check_declared(call)?;
         let vr = slice(i, call, "vr", vr, nvr)?;
         let order = slice(i, call, "order", order, nvr)?;
         let value = slice_mut(i, call, "value", value, nvr)?;

@@ -46,6 +46,26 @@ impl<M: Model> Instance<M> {
         }
     }
 
+    /// The state table's check of a derivative function `call`, then whether this FMU
+    /// declares it: the C boundary asks this before it reads the arguments.
+    pub fn check_declared(&mut self, call: Call) -> FmiResult {
+        self.check(call)?;
+        match call {
+            Call::SetRealInputDerivatives if !self.table.can_interpolate_inputs => self
+                .not_declared(
+                    call,
+                    "canInterpolateInputs is false; inputs are held over a step",
+                ),
+            Call::GetRealOutputDerivatives if self.table.max_output_derivative_order == 0 => {
+                self.not_declared(call, "maxOutputDerivativeOrder is 0")
+            }
+            Call::GetDirectionalDerivative if !self.table.provides_directional_derivative => {
+                self.not_declared(call, "providesDirectionalDerivative is false")
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// A refusal of `call`, which this FMU does not declare (`what`).
     fn not_declared(&mut self, call: Call, what: &str) -> FmiResult {
         self.refuse(
