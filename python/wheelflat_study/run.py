@@ -1,0 +1,201 @@
+"""Running a study: the cases in chunks on Dask (a local cluster by default, or an
+existing scheduler), each worker with its own persistent case runner; results kept as
+they come (``cases.jsonl``, so an interrupted study resumes), then the tables and plots.
+"""
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
+RUNNER = os.path.join(TARGET_DIR, "release", "wheelflat_case")
+
+
+def build_runner():
+    """Builds the case runner (cargo, release profile); its path."""
+    subprocess.check_call(["cargo", "build", "--release", "--quiet", "--bin", "wheelflat_case"], cwd=ROOT)
+    return RUNNER
+
+
+class CaseRunner:
+    """One persistent ``wheelflat_case`` process: a case line in, a JSON line out."""
+
+    def __init__(self, path):
+        self.path = path
+        self.proc = None
+
+    def _start(self):
+        self.proc = subprocess.Popen([self.path], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=subprocess.DEVNULL, text=True, bufsize=1)
+
+    def run(self, line):
+        if self.proc is None or self.proc.poll() is not None:
+            self._start()
+        try:
+            self.proc.stdin.write(line + "\n")
+            self.proc.stdin.flush()
+            out = self.proc.stdout.readline()
+        except (BrokenPipeError, OSError) as e:
+            out = ""
+            why = str(e)
+        else:
+            why = "no answer"
+        if not out:
+            code = self.proc.poll()
+            self.proc = None
+            return {"error": f"the case runner stopped ({why}, exit status {code})"}
+        return json.loads(out)
+
+
+_RUNNERS = {}
+
+
+def _runner(path):
+    """The case runner of this process (one per Dask worker process)."""
+    r = _RUNNERS.get(path)
+    if r is None:
+        r = _RUNNERS[path] = CaseRunner(path)
+    return r
+
+
+def run_chunk(chunk, runner_path):
+    """Runs the cases of `chunk` (a list of (case id, runner line)); a list of
+    (case id, result dict, wall seconds in this function)."""
+    out = []
+    r = _runner(runner_path)
+    for cid, line in chunk:
+        t0 = time.perf_counter()
+        try:
+            res = r.run(line)
+        except Exception as e:  # a failing case is recorded, the study goes on
+            res = {"error": f"{type(e).__name__}: {e}"}
+        out.append((cid, res, time.perf_counter() - t0))
+    return out
+
+
+def _chunks(items, size):
+    return [items[i:i + size] for i in range(0, len(items), size)]
+
+
+def load_done(out_dir):
+    """The results already in the study's folder, by case id."""
+    path = os.path.join(out_dir, "cases.jsonl")
+    done = {}
+    if os.path.exists(path):
+        with open(path) as fh:
+            for line in fh:
+                line = line.strip()
+                if not line:
+                    continue
+                try:
+                    rec = json.loads(line)
+                except json.JSONDecodeError:
+                    continue  # a line cut by an interruption: that case runs again
+                done[rec["id"]] = rec
+    return done
+
+
+def _append(out_dir, records):
+    path = os.path.join(out_dir, "cases.jsonl")
+    with open(path, "a") as fh:
+        for rec in records:
+            fh.write(json.dumps(rec) + "\n")
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=None,
+              runner_path=None, progress=True, plots=True, log=print):
+    """Runs the cases of `study` not yet in `out_dir` and writes the tables (and plots).
+
+    scheduler: the address of a running dask.distributed scheduler; None starts a
+    LocalCluster of `workers` processes (default: one per core). serial: no Dask, in
+    this process. Returns (the results table, the number of cases run now)."""
+    os.makedirs(out_dir, exist_ok=True)
+    runner_path = runner_path or RUNNER
+    cases = study.cases()
+    ids = [c.id for c in cases]
+    if len(set(ids)) != len(ids):
+        raise ValueError("the study has duplicate cases")
+    done = load_done(out_dir)
+    todo = [(c.id, c.line()) for c in cases if c.id not in done]
+    by_id = {c.id: c for c in cases}
+    log(f"{study.name}: {len(cases)} cases, {len(cases) - len(todo)} already done, {len(todo)} to run")
+    started = time.perf_counter()
+    if todo:
+        if serial:
+            _serial(todo, by_id, out_dir, runner_path, progress)
+        else:
+            _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress)
+    elapsed = time.perf_counter() - started
+    if todo:
+        log(f"ran {len(todo)} cases in {elapsed:.2f} s ({60 * len(todo) / elapsed:.0f} cases per minute)")
+    from .tables import write_tables
+    table = write_tables(study, cases, load_done(out_dir), out_dir)
+    if plots and study.plots:
+        from .plots import make_plots
+        for p in make_plots(study, table, out_dir):
+            log(f"wrote {p}")
+    return table, len(todo)
+
+
+def _record(cid, res, wall, case):
+    return {"id": cid, "params": case.params, "duration": case.duration, "keep": list(case.keep),
+            "result": res, "wall_s": wall}
+
+
+def _bar(total, progress):
+    if not progress:
+        return None
+    from tqdm import tqdm
+    return tqdm(total=total, unit="case", file=sys.stderr)
+
+
+def _serial(todo, by_id, out_dir, runner_path, progress):
+    bar = _bar(len(todo), progress)
+    for cid, line in todo:
+        [(cid, res, wall)] = run_chunk([(cid, line)], runner_path)
+        _append(out_dir, [_record(cid, res, wall, by_id[cid])])
+        if bar:
+            bar.update(1)
+    if bar:
+        bar.close()
+
+
+def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress):
+    from dask.distributed import Client, LocalCluster, as_completed
+    if scheduler:
+        client = Client(scheduler)
+        cluster = None
+    else:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None)
+        client = Client(cluster)
+    try:
+        nworkers = max(1, len(client.scheduler_info().get("workers", {})) or (workers or 1))
+        # Chunks of a few cases: the scheduler's cost per task is shared, and every
+        # worker still gets several chunks to balance the load.
+        size = chunk or max(1, min(16, len(todo) // (4 * nworkers)))
+        chunks = _chunks(todo, size)
+        futures = client.map(run_chunk, chunks, runner_path=runner_path, pure=False)
+        meta = {f.key: c for f, c in zip(futures, chunks)}
+        bar = _bar(len(todo), progress)
+        for fut in as_completed(futures):
+            try:
+                results = fut.result()
+            except Exception as e:  # a lost worker or task: its cases are recorded as failed
+                results = [(cid, {"error": f"{type(e).__name__}: {e}"}, 0.0) for cid, _ in meta[fut.key]]
+            _append(out_dir, [_record(cid, res, wall, by_id[cid]) for cid, res, wall in results])
+            if bar:
+                bar.update(len(results))
+        if bar:
+            bar.close()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
