@@ -16,7 +16,7 @@ echo "== FMUs: pack fmu/*.fmu and the C header"
 
 echo "== Python: .venv with fmpy, then the FMU tests"
 python3 python/wheelflat_fmus.py
-.venv/bin/python -m pytest -q tests/test_fmus.py
+.venv/bin/python -m pytest -q tests/test_fmus.py tests/test_study.py
 
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
 # bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and

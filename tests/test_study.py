@@ -1,0 +1,142 @@
+"""The sweep command (python -m wheelflat_study) on Dask: a local cluster against a
+serial run bit for bit, a scheduler and workers as separate processes on loopback,
+and an interrupted study resumed."""
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from wheelflat_study import load_study, run_study  # noqa: E402
+from wheelflat_study.run import ROOT, build_runner, load_done  # noqa: E402
+from wheelflat_study.tables import TIMING  # noqa: E402
+
+STUDY = """
+name = "small"
+duration = 0.12
+keep = ["rail.left.z"]
+
+[fixed]
+"track.window.ahead" = 8.0
+"track.window.behind" = 8.0
+
+[sweep]
+speed = { values = [60, 100], unit = "km/h" }
+"flat.left[1].length" = { values = [50, 100], unit = "mm" }
+"flat.left[1].angle" = { values = [10, 60], unit = "deg" }
+"""
+
+
+@pytest.fixture(scope="module")
+def runner():
+    return build_runner()
+
+
+@pytest.fixture
+def study(tmp_path):
+    p = tmp_path / "small.toml"
+    p.write_text(STUDY)
+    return p
+
+
+def comparable(table):
+    return table.drop(columns=[c for c in TIMING if c in table.columns]).reset_index(drop=True)
+
+
+def test_a_local_cluster_gives_the_serial_runs_bit_for_bit(study, tmp_path, runner):
+    s = load_study(study)
+    assert len(s.cases()) == 8
+    serial, n1 = run_study(s, str(tmp_path / "serial"), serial=True, runner_path=runner, progress=False,
+                           plots=False, log=lambda *_: None)
+    dask, n2 = run_study(s, str(tmp_path / "dask"), workers=2, chunk=1, runner_path=runner, progress=False,
+                         plots=False, log=lambda *_: None)
+    assert n1 == n2 == 8
+    assert (serial["status"] == "ok").all()
+    a, b = comparable(serial), comparable(dask)
+    assert a.equals(b)
+    # Real impacts: the 100 mm flat at 100 km/h peaks far above the static load.
+    assert a["peak.left"].max() > 2.5 * 107.66e3
+    assert a["impacts.left"].min() >= 1
+
+
+def _free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_scheduler_and_two_workers_on_loopback_give_the_same_table(study, tmp_path, runner):
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    dask = [sys.executable, "-m"]
+    procs = [subprocess.Popen(dask + ["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                                      "--no-dashboard"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        time.sleep(2.0)
+        for k in range(2):
+            procs.append(subprocess.Popen(dask + ["distributed.cli.dask_worker", addr, "--nworkers", "1", "--nthreads",
+                                                  "1", "--no-dashboard", "--name", f"w{k}"],
+                                          env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        from dask.distributed import Client
+        with Client(addr, timeout=30) as c:
+            c.wait_for_workers(2, timeout=60)
+        out = tmp_path / "remote"
+        r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(study), "--scheduler", addr, "--out", str(out),
+                            "--runner", runner, "--no-progress", "--no-plots"], env=env, capture_output=True, text=True,
+                           timeout=300)
+        assert r.returncode == 0, r.stderr
+        s = load_study(study)
+        serial, _ = run_study(s, str(tmp_path / "serial"), serial=True, runner_path=runner, progress=False,
+                              plots=False, log=lambda *_: None)
+        import pandas as pd
+        remote = pd.read_parquet(out / "results.parquet")
+        assert comparable(remote).equals(comparable(serial))
+        assert set(remote["guid"]) == set(serial["guid"]) and len(set(remote["guid"])) == 1
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+
+
+def test_an_interrupted_study_resumes_with_the_cases_it_lacks(study, tmp_path, runner):
+    out = tmp_path / "resumed"
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(study), "--serial", "--out", str(out), "--runner", runner,
+           "--no-progress", "--no-plots"]
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Interrupt it once some cases are in.
+    deadline = time.time() + 120
+    while time.time() < deadline and len(load_done(str(out))) < 3:
+        time.sleep(0.01)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    have = len(load_done(str(out)))
+    assert 3 <= have < 8, have
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert f"{have} already done, {8 - have} to run" in r.stdout, r.stdout
+    s = load_study(study)
+    import pandas as pd
+    resumed = pd.read_parquet(out / "results.parquet")
+    whole, _ = run_study(s, str(tmp_path / "whole"), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=lambda *_: None)
+    assert comparable(resumed).equals(comparable(whole))
+
+
+def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
+    p = tmp_path / "bad.toml"
+    p.write_text('name = "bad"\nduration = 0.01\n[sweep]\nspeed = [20.0, -5.0, 30.0]\n')
+    table, n = run_study(load_study(p), str(tmp_path / "bad"), serial=True, runner_path=runner, progress=False,
+                         plots=False, log=lambda *_: None)
+    assert n == 3 and list(table["status"]) == ["ok", "error", "ok"]
+    assert "`speed` = -5 m/s is out of range" in table["error"][1]
