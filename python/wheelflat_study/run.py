@@ -104,8 +104,8 @@ def _append(out_dir, records):
     with open(path, "a") as fh:
         for rec in records:
             fh.write(json.dumps(rec) + "\n")
-        fh.flush()
-        os.fsync(fh.fileno())
+        # Flushed, not synced: a killed study keeps what it wrote (the operating
+        # system has it); a line cut by a crash only runs its case again.
 
 
 def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=None,
@@ -114,7 +114,8 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
 
     scheduler: the address of a running dask.distributed scheduler; None starts a
     LocalCluster of `workers` processes (default: one per core). serial: no Dask, in
-    this process. Returns (the results table, the number of cases run now)."""
+    this process. Returns (the results table, the number of cases run now); the
+    times of the last run (start-up, the cases, the tables) are in `run_study.timing`."""
     os.makedirs(out_dir, exist_ok=True)
     runner_path = runner_path or RUNNER
     cases = study.cases()
@@ -126,16 +127,20 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
     by_id = {c.id: c for c in cases}
     log(f"{study.name}: {len(cases)} cases, {len(cases) - len(todo)} already done, {len(todo)} to run")
     started = time.perf_counter()
+    ready = started
     if todo:
         if serial:
-            _serial(todo, by_id, out_dir, runner_path, progress)
+            ready = _serial(todo, by_id, out_dir, runner_path, progress)
         else:
-            _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress)
-    elapsed = time.perf_counter() - started
+            ready = _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress)
+    finished = time.perf_counter()
+    elapsed = finished - started
     if todo:
         log(f"ran {len(todo)} cases in {elapsed:.2f} s ({60 * len(todo) / elapsed:.0f} cases per minute)")
     from .tables import write_tables
     table = write_tables(study, cases, load_done(out_dir), out_dir)
+    run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
+                        "tables_s": time.perf_counter() - finished}
     if plots and study.plots:
         from .plots import make_plots
         for p in make_plots(study, table, out_dir):
@@ -156,6 +161,9 @@ def _bar(total, progress):
 
 
 def _serial(todo, by_id, out_dir, runner_path, progress):
+    """Runs the cases here; returns when the runner was ready (perf_counter)."""
+    _runner(runner_path).run("duration=1e-9")  # starts the runner
+    ready = time.perf_counter()
     bar = _bar(len(todo), progress)
     for cid, line in todo:
         [(cid, res, wall)] = run_chunk([(cid, line)], runner_path)
@@ -164,6 +172,7 @@ def _serial(todo, by_id, out_dir, runner_path, progress):
             bar.update(1)
     if bar:
         bar.close()
+    return ready
 
 
 def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress):
@@ -177,10 +186,13 @@ def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress
                                dashboard_address=None)
         client = Client(cluster)
     try:
+        # Every worker's runner started: the cluster is ready.
+        client.run(lambda: _runner(runner_path).run("duration=1e-9") and None)
+        ready = time.perf_counter()
         nworkers = max(1, len(client.scheduler_info().get("workers", {})) or (workers or 1))
         # Chunks of a few cases: the scheduler's cost per task is shared, and every
         # worker still gets several chunks to balance the load.
-        size = chunk or max(1, min(16, len(todo) // (4 * nworkers)))
+        size = chunk or max(1, min(8, len(todo) // (8 * nworkers)))
         chunks = _chunks(todo, size)
         futures = client.map(run_chunk, chunks, runner_path=runner_path, pure=False)
         meta = {f.key: c for f, c in zip(futures, chunks)}
@@ -195,6 +207,7 @@ def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress
                 bar.update(len(results))
         if bar:
             bar.close()
+        return ready
     finally:
         client.close()
         if cluster is not None:

@@ -13,6 +13,8 @@ def _flatten(res):
     row = {}
     for wheel, p in (res.get("peak") or {}).items():
         row[f"peak.{wheel}"] = p
+    lead = [row[k] for k in ("peak.left", "peak.right") if row.get(k) is not None]
+    row["peak.max"] = max(lead) if lead else None
     for wheel in ("left", "right"):
         own = [m for m in res.get("impacts") or [] if m["wheel"] == wheel]
         row[f"impacts.{wheel}"] = len(own)
