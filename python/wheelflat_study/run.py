@@ -183,7 +183,7 @@ def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress
     else:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+                               dashboard_address=":0")
         client = Client(cluster)
     try:
         # Every worker's runner started: the cluster is ready.
