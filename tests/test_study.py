@@ -140,3 +140,42 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
                          plots=False, log=lambda *_: None)
     assert n == 3 and list(table["status"]) == ["ok", "error", "ok"]
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
+
+
+@pytest.mark.parametrize("text, said", [
+    ('name = "s"\nduration = 0.1\n[fixd]\nspeed = 20.0\n', "unknown keys ['fixd']"),
+    ('name = "s"\nduration = 0.1\n[fixed]\nspeed = 20.0\n[sweep]\nspeed = [10.0]\n', "`speed` is both fixed and swept"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { values = [40, 40], unit = "km/h" }\n', "the same case twice"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { values = [40], unit = "mph" }\n', "unit `mph`; known: MN/m, deg"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { range = [0, 1e9, 1e-3] }\n', "at most 1000000 cases"),
+    ('name = "../out"\nduration = 0.1\n', "name = `../out`"),
+    ('name = "s"\nduration = 0.1\ncombine = "zip"\n[sweep]\nspeed = [1.0, 2.0]\n"wheel.radius" = [0.4]\n',
+     "speed: 2, wheel.radius: 1"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [20.0, 300.0]\n', "`speed` = 300 is out of range: 0 <= speed <= 200"),
+    ('name = "s"\nduration = 0.1\n[sweep]\n"vehicle.mass" = [1.0]\n', "`vehicle.mass` is not a parameter"),
+])
+def test_bad_study_files_are_refused_before_anything_runs(tmp_path, runner, text, said):
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
+                        "--runner", runner, "--no-progress"], env=env, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and said in r.stderr, r.stderr
+    assert not (tmp_path / "o" / "cases.jsonl").exists()
+
+
+def test_damaged_results_and_passing_failures_run_again(study, tmp_path, runner):
+    s = load_study(study)
+    out = tmp_path / "damaged"
+    whole, _ = run_study(s, str(out), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=lambda *_: None)
+    path = out / "cases.jsonl"
+    lines = path.read_text().splitlines()
+    # A stopped runner's failure, a record cut in half, garbage: those three run again.
+    rec = __import__("json").loads(lines[0])
+    rec["result"] = {"error": "the case runner stopped (no answer, exit status None)", "transient": True}
+    path.write_text("\n".join([__import__("json").dumps(rec)] + lines[1:6] + ["[1, 2, 3]", lines[7][:40]]))
+    again, n = run_study(s, str(out), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=lambda *_: None)
+    assert n == 3
+    assert comparable(again).equals(comparable(whole))

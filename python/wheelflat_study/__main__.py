@@ -27,6 +27,9 @@ def main(argv=None):
     ap.add_argument("--no-plots", action="store_true")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--runner", help="the case runner (default: built here with cargo)")
+    ap.add_argument("--retry-failed", action="store_true",
+                    help="run again the cases that failed (those that failed for a passing reason, "
+                         "a stopped runner or a lost worker, always run again)")
     args = ap.parse_args(argv)
     try:
         study = load_study(args.study)
@@ -34,13 +37,50 @@ def main(argv=None):
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
     runner = args.runner or build_runner()
+    try:
+        check_variables(study, runner)
+        cases = study.cases()
+    except ValueError as e:
+        print(f"{args.study}: {e}", file=sys.stderr)
+        return 2
     out = args.out or os.path.join(ROOT, "results", study.name)
-    table, _ = run_study(study, out, scheduler=args.scheduler, workers=args.workers,
-                         serial=args.serial, chunk=args.chunk, runner_path=runner,
-                         progress=not args.no_progress, plots=not args.no_plots)
+    try:
+        table, _ = run_study(study, out, scheduler=args.scheduler, workers=args.workers,
+                             serial=args.serial, chunk=args.chunk, runner_path=runner,
+                             progress=not args.no_progress, plots=not args.no_plots,
+                             retry_failed=args.retry_failed)
+    except KeyboardInterrupt:
+        print("interrupted: the cases done so far are kept; run the same command to go on", file=sys.stderr)
+        return 130
+    except RuntimeError as e:
+        print(f"{args.study}: {e}", file=sys.stderr)
+        return 2
     failed = int((table["status"] == "error").sum()) if len(table) else 0
-    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} cases, {failed} failed)")
-    return 0
+    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {len(cases)} cases, "
+          f"{failed} failed)")
+    return 1 if failed else 0
+
+
+def check_variables(study, runner):
+    """Refuses, before anything runs, a variable CoupledSystem does not have and a value
+    outside its range (as fmi2SetReal would), naming both."""
+    import subprocess
+    listing = subprocess.run([runner, "--variables"], capture_output=True, text=True, check=True).stdout
+    known = {}
+    for line in listing.splitlines():
+        name, ty, lo, hi = line.split("\t")
+        known[name] = (ty, float(lo), float(hi))
+    values = dict((k, [v]) for k, v in study.fixed.items())
+    values.update(study.sweep)
+    for name, vs in values.items():
+        if name not in known:
+            raise ValueError(f"`{name}` is not a parameter or input of CoupledSystem (docs/VARIABLES.md)")
+        ty, lo, hi = known[name]
+        for v in vs:
+            if not lo <= v <= hi:
+                raise ValueError(f"`{name}` = {v:g} is out of range: {lo:g} <= {name} <= {hi:g}")
+            if ty == "Integer" and v != int(v):
+                raise ValueError(f"`{name}` = {v:g}: a whole number is needed")
 
 
 if __name__ == "__main__":

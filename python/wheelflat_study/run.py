@@ -47,7 +47,7 @@ class CaseRunner:
         if not out:
             code = self.proc.poll()
             self.proc = None
-            return {"error": f"the case runner stopped ({why}, exit status {code})"}
+            return {"error": f"the case runner stopped ({why}, exit status {code})", "transient": True}
         return json.loads(out)
 
 
@@ -72,7 +72,7 @@ def run_chunk(chunk, runner_path):
         try:
             res = r.run(line)
         except Exception as e:  # a failing case is recorded, the study goes on
-            res = {"error": f"{type(e).__name__}: {e}"}
+            res = {"error": f"{type(e).__name__}: {e}", "transient": True}
         out.append((cid, res, time.perf_counter() - t0))
     return out
 
@@ -81,27 +81,42 @@ def _chunks(items, size):
     return [items[i:i + size] for i in range(0, len(items), size)]
 
 
-def load_done(out_dir):
-    """The results already in the study's folder, by case id."""
+def load_done(out_dir, retry_failed=False):
+    """The results already in the study's folder, by case id. Lines that are not a
+    whole record (cut by an interruption, or damaged) are skipped, so their cases run
+    again; so do cases that failed for a passing reason (a stopped runner, a lost
+    worker) and, with `retry_failed`, every failed case."""
     path = os.path.join(out_dir, "cases.jsonl")
     done = {}
     if os.path.exists(path):
-        with open(path) as fh:
+        with open(path, encoding="utf-8", errors="replace") as fh:
             for line in fh:
-                line = line.strip()
-                if not line:
-                    continue
                 try:
                     rec = json.loads(line)
                 except json.JSONDecodeError:
-                    continue  # a line cut by an interruption: that case runs again
+                    continue
+                if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)
+                        and isinstance(rec.get("result"), dict)):
+                    continue
+                res = rec["result"]
+                if res.get("error") and (res.get("transient") or retry_failed):
+                    done.pop(rec["id"], None)
+                    continue
                 done[rec["id"]] = rec
     return done
 
 
 def _append(out_dir, records):
     path = os.path.join(out_dir, "cases.jsonl")
+    # A line cut by an interruption is closed first, so the next record starts a line.
+    cut = False
+    if os.path.exists(path) and os.path.getsize(path) > 0:
+        with open(path, "rb") as fh:
+            fh.seek(-1, os.SEEK_END)
+            cut = fh.read(1) != b"\n"
     with open(path, "a") as fh:
+        if cut:
+            fh.write("\n")
         for rec in records:
             fh.write(json.dumps(rec) + "\n")
         # Flushed, not synced: a killed study keeps what it wrote (the operating
@@ -109,7 +124,7 @@ def _append(out_dir, records):
 
 
 def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=None,
-              runner_path=None, progress=True, plots=True, log=print):
+              runner_path=None, progress=True, plots=True, log=print, retry_failed=False):
     """Runs the cases of `study` not yet in `out_dir` and writes the tables (and plots).
 
     scheduler: the address of a running dask.distributed scheduler; None starts a
@@ -122,7 +137,7 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
         raise ValueError("the study has duplicate cases")
-    done = load_done(out_dir)
+    done = load_done(out_dir, retry_failed)
     todo = [(c.id, c.line()) for c in cases if c.id not in done]
     by_id = {c.id: c for c in cases}
     log(f"{study.name}: {len(cases)} cases, {len(cases) - len(todo)} already done, {len(todo)} to run")
@@ -143,7 +158,7 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:
         from .plots import make_plots
-        for p in make_plots(study, table, out_dir):
+        for p in make_plots(study, table, out_dir, log):
             log(f"wrote {p}")
     return table, len(todo)
 
@@ -178,8 +193,14 @@ def _serial(todo, by_id, out_dir, runner_path, progress):
 def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress):
     from dask.distributed import Client, LocalCluster, as_completed
     if scheduler:
-        client = Client(scheduler)
+        client = Client(scheduler, timeout=60)
         cluster = None
+        try:
+            client.wait_for_workers(1, timeout=120)
+        except Exception:
+            client.close()
+            raise RuntimeError(f"the scheduler {scheduler} has no workers after 120 s: start some "
+                               f"(dask worker {scheduler}) with PYTHONPATH={os.path.join(ROOT, 'python')}")
     else:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,

@@ -5,8 +5,18 @@ import itertools
 import json
 import math
 import random
+import re
 import tomllib
 from dataclasses import dataclass, field
+
+# The most cases one study may have.
+MAX_CASES = 1_000_000
+# The keys a study file may have, and those of a sweep entry.
+TOP_KEYS = {"name", "duration", "keep", "combine", "fixed", "sweep", "plot"}
+SWEEP_KEYS = {"values", "range", "random", "unit"}
+RANDOM_KEYS = {"low", "high", "n", "seed"}
+PLOT_KEYS = {"kind", "x", "y", "z", "by", "scale", "label", "title", "name"}
+PLOT_KINDS = {"lines": ("x", "y"), "heatmap": ("x", "y", "z"), "phase": ("x", "y", "z")}
 
 # Units a study may give values in, to SI.
 UNITS = {None: 1.0, "": 1.0, "km/h": 1 / 3.6, "mm": 1e-3, "deg": math.pi / 180, "kN": 1e3,
@@ -47,13 +57,21 @@ class Study:
     plots: list = field(default_factory=list)
     display: dict = field(default_factory=dict)  # name -> (unit, factor to the unit)
 
+    def count(self):
+        """The number of cases."""
+        lens = [len(v) for v in self.sweep.values()]
+        if self.combine == "zip":
+            return lens[0] if lens else 1
+        return math.prod(lens)
+
     def cases(self):
         names = list(self.sweep)
         lists = [self.sweep[n] for n in names]
         if self.combine == "zip":
             n = {len(v) for v in lists}
             if len(n) > 1:
-                raise ValueError(f"combine = zip needs lists of one length; got {sorted(n)}")
+                lens = ", ".join(f"{k}: {len(v)}" for k, v in self.sweep.items())
+                raise ValueError(f"combine = zip needs every swept variable to have as many values ({lens})")
             rows = zip(*lists)
         else:
             rows = itertools.product(*lists)
@@ -62,31 +80,60 @@ class Study:
             params = dict(self.fixed)
             params.update(zip(names, row))
             out.append(Case(params, self.duration, tuple(self.keep)))
+        seen = {}
+        for c in out:
+            if c.id in seen:
+                swept = {k: c.params[k] for k in names}
+                raise ValueError(f"the study has the same case twice: {swept} (repeated values in the sweep)")
+            seen[c.id] = c
         return out
+
+
+def _number(where, v):
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ValueError(f"{where}: `{v}` is not a finite number")
+    return float(v)
+
+
+def _unit(where, unit):
+    if unit not in UNITS:
+        raise ValueError(f"{where}: unit `{unit}`; known: {', '.join(sorted(u for u in UNITS if u))}")
+    return unit
 
 
 def _values(name, entry):
     """The SI values of one swept variable's entry, and its display unit."""
     unit = None
+    where = f"sweep `{name}`"
     if isinstance(entry, list):
         values = entry
     elif isinstance(entry, dict):
-        unit = entry.get("unit")
-        if unit not in UNITS:
-            raise ValueError(f"sweep `{name}`: unit `{unit}`; known: {sorted(u for u in UNITS if u)}")
+        extra = set(entry) - SWEEP_KEYS
+        if extra or len(set(entry) & {"values", "range", "random"}) != 1:
+            raise ValueError(f"{where}: give exactly one of values, range or random (and unit); "
+                             f"got {sorted(entry)}")
+        unit = _unit(where, entry.get("unit"))
         if "values" in entry:
             values = entry["values"]
         elif "range" in entry:
             r = entry["range"]
             if len(r) != 3 or not r[2] > 0:
                 raise ValueError(f"sweep `{name}`: range = [start, stop, step] with step > 0")
-            start, stop, step = r
+            start, stop, step = (_number(where, x) for x in r)
             n = int(math.floor((stop - start) / step + 1e-9)) + 1
+            if n > MAX_CASES:
+                raise ValueError(f"{where}: range gives {n} values; at most {MAX_CASES} cases a study")
             values = [start + i * step for i in range(n)]
         elif "random" in entry:
             r = entry["random"]
+            if not isinstance(r, dict) or set(r) - RANDOM_KEYS or not {"low", "high", "n"} <= set(r):
+                raise ValueError(f"{where}: random = {{ low, high, n, seed }} (seed optional)")
+            n = int(_number(where, r["n"]))
+            if not 1 <= n <= MAX_CASES:
+                raise ValueError(f"{where}: random n = {n}; allowed 1 to {MAX_CASES}")
             rng = random.Random(r.get("seed", 0))
-            values = [rng.uniform(r["low"], r["high"]) for _ in range(int(r["n"]))]
+            low, high = _number(where, r["low"]), _number(where, r["high"])
+            values = [rng.uniform(low, high) for _ in range(n)]
         else:
             raise ValueError(f"sweep `{name}`: give values, range or random")
     else:
@@ -94,34 +141,61 @@ def _values(name, entry):
     if not values:
         raise ValueError(f"sweep `{name}`: no values")
     f = UNITS[unit]
-    return [float(v) * f for v in values], unit
+    return [_number(where, v) * f for v in values], unit
 
 
 def load_study(path):
     """Reads a study file (TOML)."""
     with open(path, "rb") as fh:
-        d = tomllib.load(fh)
+        try:
+            d = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as e:
+            raise ValueError(f"not valid TOML: {e}") from None
+    extra = set(d) - TOP_KEYS
+    if extra:
+        raise ValueError(f"unknown keys {sorted(extra)}; a study has {sorted(TOP_KEYS)}")
     for key in ("name", "duration"):
         if key not in d:
-            raise ValueError(f"{path}: `{key}` is missing")
+            raise ValueError(f"`{key}` is missing")
+    name = d["name"]
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
+        raise ValueError(f"name = `{name}`: letters, digits, '_', '.', '-' (it names the results folder)")
+    duration = _number("duration", d["duration"])
+    if not 0 < duration <= 1e4:
+        raise ValueError(f"duration = {duration}: 0 < duration <= 1e4 s")
     fixed = {}
     display = {}
-    for name, entry in d.get("fixed", {}).items():
+    for var, entry in d.get("fixed", {}).items():
         if isinstance(entry, dict):
-            unit = entry.get("unit")
-            if unit not in UNITS:
-                raise ValueError(f"fixed `{name}`: unit `{unit}`")
-            fixed[name] = float(entry["value"]) * UNITS[unit]
+            if set(entry) - {"value", "unit"} or "value" not in entry:
+                raise ValueError(f"fixed `{var}`: a number or {{ value, unit }}")
+            unit = _unit(f"fixed `{var}`", entry.get("unit"))
+            fixed[var] = _number(f"fixed `{var}`", entry["value"]) * UNITS[unit]
         else:
-            fixed[name] = float(entry)
+            fixed[var] = _number(f"fixed `{var}`", entry)
     sweep = {}
-    for name, entry in d.get("sweep", {}).items():
-        sweep[name], unit = _values(name, entry)
+    for var, entry in d.get("sweep", {}).items():
+        if var in fixed:
+            raise ValueError(f"`{var}` is both fixed and swept")
+        sweep[var], unit = _values(var, entry)
         if unit:
-            display[name] = (unit, 1 / UNITS[unit])
+            display[var] = (unit, 1 / UNITS[unit])
     combine = d.get("combine", "product")
     if combine not in ("product", "zip"):
         raise ValueError(f"combine = `{combine}`: product or zip")
-    return Study(name=d["name"], duration=float(d["duration"]), fixed=fixed, sweep=sweep,
-                 combine=combine, keep=tuple(d.get("keep", ())), plots=d.get("plot", []),
-                 display=display)
+    keep = d.get("keep", [])
+    if not isinstance(keep, list) or not all(isinstance(k, str) and k for k in keep):
+        raise ValueError("keep: a list of output names")
+    plots = d.get("plot", [])
+    for i, p in enumerate(plots):
+        kind = p.get("kind", "lines")
+        if kind not in PLOT_KINDS or set(p) - PLOT_KEYS:
+            raise ValueError(f"plot {i + 1}: kind one of {sorted(PLOT_KINDS)}, keys {sorted(PLOT_KEYS)}")
+        missing = [k for k in PLOT_KINDS[kind] if k not in p]
+        if missing:
+            raise ValueError(f"plot {i + 1} ({kind}): needs {missing}")
+    study = Study(name=name, duration=duration, fixed=fixed, sweep=sweep, combine=combine,
+                  keep=tuple(keep), plots=plots, display=display)
+    if study.count() > MAX_CASES:
+        raise ValueError(f"{study.count()} cases; at most {MAX_CASES} a study")
+    return study

@@ -47,10 +47,14 @@ fn parse(line: &str) -> Result<Case, String> {
         duration: f64::NAN,
         keep: Vec::new(),
     };
+    let mut seen = std::collections::HashSet::new();
     for token in line.split_whitespace() {
         let (name, value) = token
             .split_once('=')
             .ok_or_else(|| format!("`{token}`: expected NAME=VALUE"))?;
+        if !seen.insert(name.to_string()) {
+            return Err(format!("`{name}` is given twice in one case"));
+        }
         match name {
             "keep" => {
                 case.keep = value
@@ -354,17 +358,44 @@ fn run(case: &Case) -> Result<String, String> {
     Ok(o)
 }
 
-fn main() {
-    let stdin = std::io::stdin();
+/// `--variables`: CoupledSystem's parameters and inputs, one per line: name, type,
+/// min, max (for the sweep command's checks before a study starts).
+fn list_variables() {
     let mut out = std::io::stdout().lock();
-    for line in stdin.lock().lines() {
-        let Ok(line) = line else { break };
-        if line.trim().is_empty() {
-            continue;
+    for v in Kind::CoupledSystem.table().vars {
+        if matches!(v.causality, Causality::Parameter | Causality::Input) {
+            let ty = match v.ty {
+                VarType::Real => "Real",
+                _ => "Integer",
+            };
+            let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}", v.name, v.min, v.max);
         }
+    }
+}
+
+fn main() {
+    if std::env::args().nth(1).as_deref() == Some("--variables") {
+        list_variables();
+        return;
+    }
+    let mut stdin = std::io::stdin().lock();
+    let mut out = std::io::stdout().lock();
+    let mut bytes = Vec::new();
+    loop {
+        bytes.clear();
+        match stdin.read_until(b'\n', &mut bytes) {
+            Ok(0) | Err(_) => break,
+            Ok(_) => {}
+        }
+        // Every line gets one answer, a line that is not UTF-8 or holds no case too.
+        let line = String::from_utf8_lossy(&bytes).trim().to_string();
         // A panic in a case is reported as that case's error; the runner goes on.
-        let result = std::panic::catch_unwind(|| parse(&line).and_then(|c| run(&c)))
-            .unwrap_or_else(|_| Err("internal error (panic) in the case runner".into()));
+        let result = if line.is_empty() {
+            Err("an empty case line: give NAME=VALUE tokens and duration=S".into())
+        } else {
+            std::panic::catch_unwind(|| parse(&line).and_then(|c| run(&c)))
+                .unwrap_or_else(|_| Err("internal error (panic) in the case runner".into()))
+        };
         let text = match result {
             Ok(s) => s,
             Err(e) => format!(
