@@ -33,6 +33,26 @@ fn guid(content: &str) -> String {
     )
 }
 
+/// The unit definitions `section` less the units none of the variables `fv` uses (one
+/// `<Unit>` per line in the table); `None` when none is used.
+fn used_units(section: &str, fv: &[crate::table::FmuVar]) -> Option<String> {
+    let used: std::collections::BTreeSet<&str> = fv.iter().filter_map(|v| v.get("unit")).collect();
+    let mut kept = 0;
+    let lines: Vec<&str> = section
+        .lines()
+        .filter(|l| {
+            let Some(rest) = l.trim_start().strip_prefix("<Unit name=\"") else {
+                return true;
+            };
+            let name = &rest[..rest.find('"').expect("a closed unit name")];
+            let keep = used.contains(name);
+            kept += usize::from(keep);
+            keep
+        })
+        .collect();
+    (kept > 0).then(|| lines.join("\n"))
+}
+
 /// The model description of `fmu` (package version `version`) and its GUID.
 pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     let id = fmu.id();
@@ -47,6 +67,7 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription\n  \
          fmiVersion=\"2.0\"\n  modelName=\"{id}\"\n  guid=\"@GUID@\"\n  \
          description=\"{desc}\"\n  author=\"wheelflat developers\"\n  \
+         copyright=\"Copyright (c) 2026 wheelflat developers\"\n  license=\"MIT\"\n  \
          version=\"{version}\"\n  generationTool=\"wheelflat build.rs\"\n  \
          variableNamingConvention=\"structured\"\n  numberOfEventIndicators=\"0\">\n  \
          <CoSimulation\n    modelIdentifier=\"{id}\"\n    needsExecutionTool=\"false\"\n    \
@@ -58,7 +79,13 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     )
     .unwrap();
     for s in RAW_SECTIONS {
-        writeln!(md, "  {}", table.sections[s]).unwrap();
+        let text = match s {
+            "UnitDefinitions" => used_units(&table.sections[s], fv),
+            _ => Some(table.sections[s].clone()),
+        };
+        if let Some(text) = text {
+            writeln!(md, "  {text}").unwrap();
+        }
     }
     writeln!(
         md,

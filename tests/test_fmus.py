@@ -1056,3 +1056,23 @@ def test_a_bogie_step_beyond_the_axle_box_limit_is_warned(paths):
     b.fmu.doStep(1e-3, 5e-3)
     assert "is above about 0.00222" in log.text(), log.text()
     b.close()
+
+
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+def test_model_descriptions_declare_the_units_they_use_and_a_license(paths, name):
+    import xml.etree.ElementTree as ET
+    with zipfile.ZipFile(paths[name]) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    assert root.get("license") == "MIT" and "Copyright" in root.get("copyright")
+    declared = {u.get("name") for u in root.iter("Unit")}
+    used = {r.get("unit") for r in root.iter("Real") if r.get("unit")}
+    assert declared == used, (declared - used, used - declared)
+
+
+def test_setup_experiment_logs_no_undefined_stop_time(paths):
+    log = Log()
+    u = wf.Unit(paths["CoupledSystem"], "u", callbacks=log.callbacks, logging_on=True)
+    u.fmu.setDebugLogging(True, ["logCalls"])
+    u.fmu.setupExperiment(startTime=0.0)
+    assert "stopTime undefined" in log.text() and "stopTime=0" not in log.text(), log.text()
+    u.close(terminate=False)

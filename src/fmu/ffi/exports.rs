@@ -164,9 +164,13 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 ) -> fmi2Status {
     let call = Call::SetupExperiment;
     with(c, call, |i| {
-        i.log_call(|| format!("fmi2SetupExperiment(startTime={startTime}, stopTime={stopTime})"));
         boolean(i, call, "toleranceDefined", toleranceDefined)?;
         let stop_defined = boolean(i, call, "stopTimeDefined", stopTimeDefined)?;
+        // A stop time the master did not define is not shown as one.
+        i.log_call(|| match stop_defined {
+            true => format!("fmi2SetupExperiment(startTime={startTime}, stopTime={stopTime})"),
+            false => format!("fmi2SetupExperiment(startTime={startTime}, stopTime undefined)"),
+        });
         i.setup_experiment(startTime, stop_defined.then_some(stopTime))
     })
 }
