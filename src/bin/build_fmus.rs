@@ -35,6 +35,54 @@ fn main() {
     }
 }
 
+/// The shared library `lib` stripped of its symbol table and debug sections (its
+/// exported functions stay), by binutils' `objcopy`; the symbols go to
+/// `out/debug/<name>.debug`, which the stripped library names (`.gnu_debuglink`) so a
+/// debugger finds them. Without `objcopy` the library is packed as it is, with a note.
+fn stripped(lib: &Path, out: &Path) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
+    let name = lib
+        .file_name()
+        .ok_or("a library file name")?
+        .to_string_lossy();
+    let debug_dir = out.join("debug");
+    std::fs::create_dir_all(&debug_dir)?;
+    let debug = debug_dir.join(format!("{name}.debug"));
+    let slim = debug_dir.join(format!("{name}.stripped"));
+    let objcopy = |args: &[&std::ffi::OsStr]| {
+        std::process::Command::new("objcopy")
+            .args(args)
+            .status()
+            .map(|s| s.success())
+            .unwrap_or(false)
+    };
+    let ok = objcopy(&[
+        "--only-keep-debug".as_ref(),
+        lib.as_os_str(),
+        debug.as_os_str(),
+    ]) && objcopy(&[
+        "--strip-unneeded".as_ref(),
+        format!("--add-gnu-debuglink={}", debug.display()).as_ref(),
+        lib.as_os_str(),
+        slim.as_os_str(),
+    ]);
+    if !ok {
+        eprintln!(
+            "build_fmus: objcopy (binutils) not found or failed: the library is packed unstripped"
+        );
+        return Ok(std::fs::read(lib)?);
+    }
+    let bytes = std::fs::read(&slim)?;
+    std::fs::remove_file(&slim)?;
+    println!(
+        "{} stripped: {} bytes ({} before; symbols in {})",
+        name,
+        bytes.len(),
+        std::fs::metadata(lib)?.len(),
+        debug.display()
+    );
+    Ok(bytes)
+}
+
 fn run() -> Result<(), Box<dyn std::error::Error>> {
     let out: PathBuf = std::env::args()
         .nth(1)
@@ -45,12 +93,14 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .parent()
         .ok_or("executable has no directory")?
         .join(PLATFORM.1);
-    let binary = std::fs::read(&lib).map_err(|e| {
-        format!(
-            "cannot read the shared library {}: {e}; build it first with `cargo build --release`",
+    if !lib.exists() {
+        return Err(format!(
+            "cannot read the shared library {}; build it first with `cargo build --release`",
             lib.display()
         )
-    })?;
+        .into());
+    }
+    let binary = stripped(&lib, &out)?;
     // A second argument: where to write the variables' documentation.
     if let Some(doc) = std::env::args().nth(2) {
         std::fs::write(&doc, VARIABLES_MD)?;
