@@ -1076,3 +1076,13 @@ def test_setup_experiment_logs_no_undefined_stop_time(paths):
     u.fmu.setupExperiment(startTime=0.0)
     assert "stopTime undefined" in log.text() and "stopTime=0" not in log.text(), log.text()
     u.close(terminate=False)
+
+
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+def test_each_fmu_carries_its_icon(paths, name):
+    import io
+    import matplotlib.image as mpimg
+    with zipfile.ZipFile(paths[name]) as z:
+        img = mpimg.imread(io.BytesIO(z.read("model.png")), format="png")
+    assert img.shape == (128, 128, 4)
+    assert (img[:, :, 3] > 0).mean() > 0.15  # a drawing, not an empty picture

@@ -9,6 +9,8 @@
 //! [VARIABLES.md]]`; the second argument writes the variables' documentation generated
 //! from the table there (`docs/VARIABLES.md`).
 
+mod icons;
+
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use wheelflat::fmu::vars::{C_HEADER, FMUS, VARIABLES_MD};
@@ -124,6 +126,8 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             opts.unix_permissions(0o755),
         )?;
         z.write_all(&binary)?;
+        z.start_file("model.png", opts)?;
+        z.write_all(&icons::icon(t.model_identifier))?;
         let (_, page) = pages::DOCUMENTATION
             .iter()
             .find(|(id, _)| *id == t.model_identifier)
