@@ -91,10 +91,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("fmu"));
     let exe = std::env::current_exe()?;
-    let lib = exe
-        .parent()
-        .ok_or("executable has no directory")?
-        .join(PLATFORM.1);
+    // $WHEELFLAT_FMU_LIBRARY: the library to pack (the glibc 2.28 build of
+    // `scripts/build_fmus_glibc228.sh`); by default the one beside this executable.
+    let lib = match std::env::var_os("WHEELFLAT_FMU_LIBRARY") {
+        Some(p) => PathBuf::from(p),
+        None => exe
+            .parent()
+            .ok_or("executable has no directory")?
+            .join(PLATFORM.1),
+    };
     if !lib.exists() {
         return Err(format!(
             "cannot read the shared library {}; build it first with `cargo build --release`",
