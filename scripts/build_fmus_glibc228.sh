@@ -5,8 +5,11 @@
 # version above 2.28 is needed. The normal `cargo build` and `build_fmus` are untouched.
 #   bash scripts/build_fmus_glibc228.sh [OUT_DIR]
 set -euo pipefail
+# A relative OUT_DIR is the caller's, resolved before moving to the repository.
+out="${1:-$(dirname "$0")/../fmu}"
+mkdir -p "$out"
+out="$(cd "$out" && pwd)"
 cd "$(dirname "$0")/.."
-out="${1:-fmu}"
 python3 python/wheelflat_fmus.py >/dev/null          # .venv
 .venv/bin/python -m pip install -q "ziglang==0.17.1"
 export PATH="$(.venv/bin/python -c 'import ziglang, os; print(os.path.dirname(ziglang.__file__))'):$HOME/.cargo/bin:$PATH"

@@ -4,13 +4,15 @@
 # system with debootstrap from Debian's packages in a folder of its own, and runs
 # CoupledSystem there through its C interface with that system's Python
 # (tests/old_glibc/harness.py, standard library only); the peak must equal the host's
-# bit for bit. Needs root and Debian's package servers; about 5 minutes the first time.
+# bit for bit. Needs root and Debian's package servers; about 1.5 minutes of debootstrap
+# the first time, seconds after.
 #   bash scripts/test_old_glibc.sh [WORK_DIR]     (kept, so a second run reuses the root)
 set -euo pipefail
-cd "$(dirname "$0")/.."
+# A relative WORK_DIR is the caller's, resolved before moving to the repository.
 work="${1:-$(mktemp -d)}"
 mkdir -p "$work"
 work="$(cd "$work" && pwd)"
+cd "$(dirname "$0")/.."
 bash scripts/build_fmus_glibc228.sh "$work/fmu"
 root="$work/bullseye"
 if [ ! -x "$root/usr/bin/python3" ]; then
