@@ -148,16 +148,12 @@ impl Simulation {
                     since,
                     rates,
                 } => {
+                    if let Some(&x) = e.iter().find(|x| !x.is_finite()) {
+                        return Err(out_of_range("state: wheel inputs", x, "finite"));
+                    }
                     *wheel_z = [e[0], e[1]];
                     *rotation = e[2];
                     *since = e[3];
-                    if !e.iter().all(|x| x.is_finite()) {
-                        return Err(out_of_range(
-                            "state: wheel inputs",
-                            e.iter().copied().find(|x| !x.is_finite()).unwrap_or(0.0),
-                            "finite",
-                        ));
-                    }
                     *rates = InputRates::from_slice(&e[4..4 + InputRates::LEN]);
                 }
                 _ => {}

@@ -53,9 +53,14 @@ pub struct VehicleUnitParams {
 #[derive(Debug, Clone)]
 enum Body {
     /// The roll-plane vehicle, the contact forces in.
-    RollPlane,
-    /// The roll-plane vehicle above its primary suspension, the primary forces in.
-    Sprung(Box<SprungBogie>),
+    RollPlane(Box<RollPlaneVehicle>),
+    /// The roll-plane vehicle above its primary suspension, the primary forces in;
+    /// `rest`, the whole vehicle at rest on the static wheel heights, gives the
+    /// wheelset's outputs (the partner carries the wheelset).
+    Sprung {
+        bogie: Box<SprungBogie>,
+        rest: Box<RollPlaneVehicle>,
+    },
     /// The half-car bogie, the four contact forces in.
     HalfCar(Box<HalfCarBogie>),
     /// The half-car bogie above its primary suspension, the four primary forces in.
@@ -72,9 +77,6 @@ enum Body {
 #[derive(Debug, Clone)]
 pub struct VehicleUnit {
     params: VehicleUnitParams,
-    /// The roll-plane vehicle: it steps with [`Body::RollPlane`]; otherwise it rests
-    /// on the static wheel heights (the wheelset's outputs of the axle-box interface).
-    vehicle: RollPlaneVehicle,
     body: Body,
     /// Equal substeps of at most the base step; steps shorter than
     /// [`MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
@@ -131,21 +133,24 @@ impl VehicleUnit {
                 ),
             ));
         }
-        // The roll-plane vehicle is built for the roll-plane variants' outputs; its own
-        // critical step may be shorter than the half-car's step, so it rests on a step
-        // it accepts when it does not step.
-        let rest_dt = dt.min(0.5 * p.vehicle.critical_time_step());
-        let mut vehicle = RollPlaneVehicle::new(p.vehicle, rest_dt)?;
-        vehicle.set_static(p.static_wheel_z)?;
+        let roll_plane_at_rest = || -> Result<Box<RollPlaneVehicle>> {
+            let mut v = RollPlaneVehicle::new(p.vehicle, dt)?;
+            v.set_static(p.static_wheel_z)?;
+            Ok(Box::new(v))
+        };
         let wheels = [p.static_wheel_z, p.trailing_static_wheel_z];
         let mut force = [[p.vehicle.static_wheel_load(); 2]; 2];
         let body = match (&p.half_car, p.axle_box) {
-            (None, false) => Body::RollPlane,
+            (None, false) => Body::RollPlane(roll_plane_at_rest()?),
             (None, true) => {
                 let mut b = SprungBogie::new(p.vehicle, dt)?;
                 b.set_static(p.static_wheel_z)?;
-                force[0] = vehicle.bearing_forces();
-                Body::Sprung(Box::new(b))
+                let rest = roll_plane_at_rest()?;
+                force[0] = rest.bearing_forces();
+                Body::Sprung {
+                    bogie: Box::new(b),
+                    rest,
+                }
             }
             (Some(h), false) => {
                 let mut b = HalfCarBogie::new(*h, dt)?;
@@ -161,7 +166,6 @@ impl VehicleUnit {
         };
         let unit = VehicleUnit {
             params: *p,
-            vehicle,
             body,
             clock: Clock::new(dt, Stepping::Substeps),
             force,
@@ -219,7 +223,7 @@ impl VehicleUnit {
             return None;
         }
         Some(match &self.body {
-            Body::RollPlane | Body::Sprung(_) => self.vehicle.wheel_z(),
+            Body::RollPlane(v) | Body::Sprung { rest: v, .. } => v.wheel_z(),
             Body::HalfCar(b) => b.wheel_z()[k],
             Body::SprungHalfCar(_) if k == 0 => self.params.static_wheel_z,
             Body::SprungHalfCar(_) => self.params.trailing_static_wheel_z,
@@ -235,15 +239,15 @@ impl VehicleUnit {
         }
         let h = 0.5 * self.params.vehicle.primary_spacing;
         let (z, phi) = match &self.body {
-            Body::RollPlane => {
-                let v = self.vehicle.velocities();
+            Body::RollPlane(v) => {
+                let v = v.velocities();
                 (v[4], v[5])
             }
             Body::HalfCar(b) => {
                 let v = b.velocities();
                 (v[6 + 2 * k], v[7 + 2 * k])
             }
-            Body::Sprung(_) | Body::SprungHalfCar(_) => (0.0, 0.0),
+            Body::Sprung { .. } | Body::SprungHalfCar(_) => (0.0, 0.0),
         };
         Some([z - h * phi, z + h * phi])
     }
@@ -252,13 +256,15 @@ impl VehicleUnit {
     /// ones (the partner carries it). Zero for the half-car bogie
     /// ([`VehicleUnit::half_car_displacements`]).
     pub fn displacements(&self) -> Vector6<f64> {
-        let mut d = *self.vehicle.displacements();
         match &self.body {
-            Body::RollPlane => {}
-            Body::Sprung(b) => d.fixed_rows_mut::<4>(0).copy_from(b.displacements()),
-            Body::HalfCar(_) | Body::SprungHalfCar(_) => d = Vector6::zeros(),
+            Body::RollPlane(v) => *v.displacements(),
+            Body::Sprung { bogie, rest } => {
+                let mut d = *rest.displacements();
+                d.fixed_rows_mut::<4>(0).copy_from(bogie.displacements());
+                d
+            }
+            Body::HalfCar(_) | Body::SprungHalfCar(_) => Vector6::zeros(),
         }
-        d
     }
     /// Displacements of the half-car bogie (m, rad), in the order of
     /// [`crate::vehicle::HALF_CAR_DOF_NAMES`]; with the axle-box interface the
@@ -290,8 +296,8 @@ impl VehicleUnit {
             return None;
         }
         Some(match &self.body {
-            Body::RollPlane => self.vehicle.bearing_forces(),
-            Body::Sprung(_) | Body::SprungHalfCar(_) => self.force[k],
+            Body::RollPlane(v) => v.bearing_forces(),
+            Body::Sprung { .. } | Body::SprungHalfCar(_) => self.force[k],
             Body::HalfCar(b) => b.bearing_forces()[k],
         })
     }
@@ -308,9 +314,9 @@ impl VehicleUnit {
             return None;
         }
         Some(match &self.body {
-            Body::Sprung(b) => b.side_frames(),
-            Body::RollPlane => {
-                let (d, v) = (self.vehicle.displacements(), self.vehicle.velocities());
+            Body::Sprung { bogie, .. } => bogie.side_frames(),
+            Body::RollPlane(r) => {
+                let (d, v) = (r.displacements(), r.velocities());
                 ([d[2], d[3]], [v[2], v[3]])
             }
             Body::HalfCar(b) => b.side_frames_of(k),
@@ -348,7 +354,7 @@ impl VehicleUnit {
 
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
-        matches!(self.body, Body::Sprung(_) | Body::SprungHalfCar(_))
+        matches!(self.body, Body::Sprung { .. } | Body::SprungHalfCar(_))
     }
     /// The held forces `[left, right]` (N) of wheelset `k` (contact, or primary with the
     /// axle-box interface); `None` for a wheelset the vehicle does not have.
@@ -463,8 +469,8 @@ impl VehicleUnit {
         self.clock.carried = 0.0;
         if let Some(dt) = s.dt {
             match &mut self.body {
-                Body::RollPlane => self.vehicle.change_dt(dt)?,
-                Body::Sprung(b) => b.change_dt(dt)?,
+                Body::RollPlane(v) => v.change_dt(dt)?,
+                Body::Sprung { bogie, .. } => bogie.change_dt(dt)?,
                 Body::HalfCar(b) => b.change_dt(dt)?,
                 Body::SprungHalfCar(b) => b.change_dt(dt)?,
             }
@@ -475,8 +481,8 @@ impl VehicleUnit {
         }
         let n = s.n as u64;
         match &mut self.body {
-            Body::RollPlane => (0..n).for_each(|_| self.vehicle.step(self.force[0])),
-            Body::Sprung(b) => (0..n).for_each(|_| b.step(self.force[0])),
+            Body::RollPlane(v) => (0..n).for_each(|_| v.step(self.force[0])),
+            Body::Sprung { bogie, .. } => (0..n).for_each(|_| bogie.step(self.force[0])),
             Body::HalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
             Body::SprungHalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
         }
@@ -523,8 +529,8 @@ impl VehicleUnit {
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
         let bad = match &self.body {
-            Body::RollPlane => self.vehicle.beyond_bounds(),
-            Body::Sprung(b) => b.beyond_bounds(),
+            Body::RollPlane(v) => v.beyond_bounds(),
+            Body::Sprung { bogie, .. } => bogie.beyond_bounds(),
             Body::HalfCar(b) => b.beyond_bounds(),
             Body::SprungHalfCar(b) => b.beyond_bounds(),
         };
@@ -575,8 +581,8 @@ impl VehicleUnit {
     /// The body's state vector.
     fn body_state(&self) -> Vec<f64> {
         match &self.body {
-            Body::RollPlane => self.vehicle.state_vector(),
-            Body::Sprung(b) => b.state_vector(),
+            Body::RollPlane(v) => v.state_vector(),
+            Body::Sprung { bogie, .. } => bogie.state_vector(),
             Body::HalfCar(b) => b.state_vector(),
             Body::SprungHalfCar(b) => b.state_vector(),
         }
@@ -645,8 +651,8 @@ impl VehicleUnit {
         }
         let body = &v[head..];
         match &mut self.body {
-            Body::RollPlane => self.vehicle.set_state_vector(body)?,
-            Body::Sprung(b) => b.set_state_vector(body)?,
+            Body::RollPlane(v) => v.set_state_vector(body)?,
+            Body::Sprung { bogie, .. } => bogie.set_state_vector(body)?,
             Body::HalfCar(b) => b.set_state_vector(body)?,
             Body::SprungHalfCar(b) => b.set_state_vector(body)?,
         }

@@ -62,6 +62,23 @@ fn wheels_of(p: &HalfCarParams, d: &HalfCarVector) -> Quad {
     })
 }
 
+/// The primary (bearing) forces at the four axle boxes (N), positive pressing the
+/// wheelsets down, of the state `d` moving at `v`: `-(K_1 (z_sf - z_box) + C_1 (v_sf -
+/// v_box))`, the side frame taken at the axle (its pitch included).
+fn primary_forces(p: &HalfCarParams, d: &HalfCarVector, v: &HalfCarVector) -> Quad {
+    let (zf, vf) = (
+        p.frames_at_boxes(d.as_slice()),
+        p.frames_at_boxes(v.as_slice()),
+    );
+    let (zb, vb) = (wheels_of(p, d), wheels_of(p, v));
+    [0, 1].map(|i| {
+        [0, 1].map(|s| {
+            -(p.primary_stiffness * (zf[i][s] - zb[i][s])
+                + p.primary_damping * (vf[i][s] - vb[i][s]))
+        })
+    })
+}
+
 /// The first value beyond the health bounds: a body at `t_j` or `t_(j-1)` beyond
 /// [`BODY_DISPLACEMENT_LIMIT`].
 fn bodies_beyond<const N: usize>(cd: &CentralDifference<N>) -> Option<(&'static str, f64, f64)> {
@@ -143,19 +160,7 @@ impl HalfCarBogie {
     /// the wheelsets down: `-(K_1 (z_sf - z_box) + C_1 (v_sf - v_box))`, the side frame
     /// taken at the axle (its pitch included), the velocities backward differences.
     pub fn bearing_forces(&self) -> Quad {
-        let p = &self.params;
-        let v = self.cd.velocities();
-        let (zf, vf) = (
-            p.frames_at_boxes(self.cd.d().as_slice()),
-            p.frames_at_boxes(v.as_slice()),
-        );
-        let (zb, vb) = (wheels_of(p, self.cd.d()), wheels_of(p, &v));
-        [0, 1].map(|i| {
-            [0, 1].map(|s| {
-                -(p.primary_stiffness * (zf[i][s] - zb[i][s])
-                    + p.primary_damping * (vf[i][s] - vb[i][s]))
-            })
-        })
+        primary_forces(&self.params, self.cd.d(), &self.cd.velocities())
     }
 
     /// Advances one step from `t_j` under the contact forces `p` (N, up on the wheels)
@@ -299,9 +304,8 @@ impl SprungHalfCar {
         let d = self.params.static_state(z_wheel).ok_or_else(not_held)?;
         let top = d.fixed_rows::<6>(0).into_owned();
         self.cd.set_state(top, top);
-        let mut whole = HalfCarBogie::new(self.params, self.dt())?;
-        whole.cd.set_state(d, d);
-        Ok(whole.bearing_forces())
+        // At rest: the springs alone.
+        Ok(primary_forces(&self.params, &d, &HalfCarVector::zeros()))
     }
 
     /// Changes the step to `dt` (s), as [`HalfCarBogie::change_dt`].

@@ -90,13 +90,7 @@ impl<M: Model> Instance<M> {
         values: &[f64],
     ) -> FmiResult {
         let call = Call::SetRealInputDerivatives;
-        self.check(call)?;
-        if !self.table.can_interpolate_inputs {
-            return self.not_declared(
-                call,
-                "canInterpolateInputs is false; inputs are held over a step",
-            );
-        }
+        self.check_declared(call)?;
         for &r in vrs {
             self.real_of(call, r, Causality::Input)?;
         }
@@ -130,11 +124,8 @@ impl<M: Model> Instance<M> {
         out: &mut [f64],
     ) -> FmiResult {
         let call = Call::GetRealOutputDerivatives;
-        self.check(call)?;
+        self.check_declared(call)?;
         let max = self.table.max_output_derivative_order;
-        if max == 0 {
-            return self.not_declared(call, "maxOutputDerivativeOrder is 0");
-        }
         for (&r, &o) in vrs.iter().zip(orders) {
             self.real_of(call, r, Causality::Output)?;
             if o < 1 || o as u32 > max {
@@ -175,10 +166,7 @@ impl<M: Model> Instance<M> {
         sensitivity: &mut [f64],
     ) -> FmiResult {
         let call = Call::GetDirectionalDerivative;
-        self.check(call)?;
-        if !self.table.provides_directional_derivative {
-            return self.not_declared(call, "providesDirectionalDerivative is false");
-        }
+        self.check_declared(call)?;
         for &r in unknowns {
             self.real_of(call, r, Causality::Output)?;
         }
