@@ -1,7 +1,15 @@
 //! Each FMU's modelDescription.xml, with a GUID derived from its content: the
-//! variables in table order, the table's unit, type and log-category sections verbatim,
+//! variables in table order, the table's unit and log-category sections verbatim,
 //! and a ModelStructure whose dependencies come from the table's `dependencies` and
 //! `initialDependencies`.
+//!
+//! The table's enumerations (contact.model, interface, vehicle.model, flat shapes) are
+//! written as Integer variables with their range and their items named in the
+//! description ("1 = adaptive, 2 = hertz"), and the TypeDefinitions section is left out:
+//! OSP libcosim ignores FMI 2.0 Enumeration variables and refuses them in its system
+//! structures, and ecos does not set them, so a choice written as an Enumeration cannot
+//! be made in either. Both read and write Integer. The names stay in the table, which
+//! gives them to the Rust binding, docs/VARIABLES.md and each FMU's documentation page.
 
 use crate::table::{Fmu, FmuVar, RAW_SECTIONS, Table};
 use std::collections::BTreeMap;
@@ -81,6 +89,8 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     for s in RAW_SECTIONS {
         let text = match s {
             "UnitDefinitions" => used_units(&table.sections[s], fv),
+            // No variable is written as an Enumeration (see the module's comment).
+            "TypeDefinitions" => None,
             _ => Some(table.sections[s].clone()),
         };
         if let Some(text) = text {
@@ -94,7 +104,7 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     )
     .unwrap();
     for (k, v) in fv.iter().enumerate() {
-        md.push_str(&scalar_variable(k + 1, v));
+        md.push_str(&scalar_variable(table, k + 1, v));
     }
     md.push_str("  </ModelVariables>\n  <ModelStructure>\n");
     // 1-based indices of the FMU's ModelVariables.
@@ -139,7 +149,20 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
 }
 
 /// One `<ScalarVariable>`, numbered `k` in a comment.
-fn scalar_variable(k: usize, v: &FmuVar) -> String {
+fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
+    let enumeration = v.ty() == "Enumeration";
+    let description = match (enumeration, v.get("declaredType")) {
+        (true, Some(ty)) => format!(
+            "{} ({})",
+            v.get("description").unwrap_or(""),
+            table.enums[ty]
+                .iter()
+                .map(|i| format!("{} = {}", i.value, i.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        _ => v.get("description").unwrap_or("").to_string(),
+    };
     let mut line = format!(
         "    <!-- {k} -->\n    <ScalarVariable name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\"",
         xml_escape(v.name()),
@@ -153,11 +176,18 @@ fn scalar_variable(k: usize, v: &FmuVar) -> String {
     write!(
         line,
         " description=\"{}\">\n      <{}",
-        xml_escape(v.get("description").unwrap_or("")),
-        v.ty()
+        xml_escape(&description),
+        if enumeration { "Integer" } else { v.ty() }
     )
     .unwrap();
+    if enumeration {
+        let (lo, hi) = table.enum_range(v.get("declaredType").expect("an enumeration's type"));
+        write!(line, " min=\"{lo}\" max=\"{hi}\"").unwrap();
+    }
     for k in ["declaredType", "unit", "displayUnit", "start", "min", "max"] {
+        if enumeration && k == "declaredType" {
+            continue;
+        }
         if let Some(x) = v.get(k) {
             if v.ty() != "Real" && matches!(k, "unit" | "displayUnit") {
                 continue;

@@ -34,6 +34,9 @@ fn main() {
     let mut cut = mono.clone();
     cut.vehicle = VehicleSpec::AxleBox {
         vehicle: p,
+        side_frames: wheelflat::sim::SideFrameSpec::PerWheelset {
+            mass: p.sideframe_mass,
+        },
         static_load: [p.static_wheel_load(); 2],
     };
     for h in [0.0, 1e-4, 5e-4, 1e-3, 1.44e-3, 2e-3, 3e-3, 4e-3, 5e-3, 6e-3] {

@@ -26,6 +26,9 @@ fn cut(h: f64, duration: f64, dt_bogie: f64) -> Vec<f64> {
     let mut s = mono.clone();
     s.vehicle = VehicleSpec::AxleBox {
         vehicle: p,
+        side_frames: wheelflat::sim::SideFrameSpec::PerWheelset {
+            mass: p.sideframe_mass,
+        },
         static_load: [p.static_wheel_load(); 2],
     };
     let mut sim = Simulation::new(&s).unwrap();
@@ -73,6 +76,9 @@ fn the_cut_model_starts_in_the_monolithic_static_equilibrium() {
     let mut s = mono.clone();
     s.vehicle = VehicleSpec::AxleBox {
         vehicle: p,
+        side_frames: wheelflat::sim::SideFrameSpec::PerWheelset {
+            mass: p.sideframe_mass,
+        },
         static_load: [p.static_wheel_load(); 2],
     };
     let sim = Simulation::new(&s).unwrap();

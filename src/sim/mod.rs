@@ -18,7 +18,7 @@ mod wheelset;
 
 pub use clock::StepPlan;
 pub use scenario::{
-    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, TrackWindow,
+    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
     TrailingWheelset, VehicleSpec, kmh,
 };
 pub use simulation::{

@@ -11,7 +11,9 @@
 
 use crate::contact::ContactModel;
 use crate::track::{RailEnds, RailSection, TrackParams};
-use crate::vehicle::{HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams};
+use crate::vehicle::{
+    HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
+};
 use crate::wheel::FlatSpec;
 
 /// Which track model carries the loads.
@@ -46,6 +48,9 @@ pub enum VehicleSpec {
     AxleBox {
         /// The vehicle, for its wheelset and primary suspension.
         vehicle: RollPlaneParams,
+        /// The side frames above the axle boxes, whose inertia the track carries over
+        /// each communication step ([`crate::vehicle::SideFrameInertia`]).
+        side_frames: SideFrameSpec,
         /// Static wheel loads `[left, right]` (N): the whole vehicle's
         /// ([`RollPlaneParams::static_wheel_load`]) or the bogie model's.
         static_load: [f64; 2],
@@ -406,6 +411,81 @@ impl Scenario {
     pub fn set_spans(&mut self, n: usize) {
         if let TrackSpec::Discrete(t) = &mut self.track {
             t.spans = n;
+        }
+    }
+}
+
+/// The side frames above the axle boxes with [`VehicleSpec::AxleBox`]: the track moves
+/// them on from each input under the primary forces it computes
+/// ([`crate::vehicle::PrimaryLink`]), so it needs their inertia.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SideFrameSpec {
+    /// One side frame of `mass` (kg) over each wheelset's axle box on each side, in
+    /// bounce (the roll-plane vehicle, `vehicle.sideframe.mass`).
+    PerWheelset {
+        /// Mass of one side frame (kg).
+        mass: f64,
+    },
+    /// One side frame of `mass` (kg) and `pitch_inertia` (kg m^2) on each side over the
+    /// first two wheelsets, in bounce and pitch (the half-car bogie: twice
+    /// `vehicle.sideframe.mass`, `vehicle.sideframe.pitch_inertia`), its wheelbase the
+    /// second wheelset's offset. Needs exactly two wheelsets.
+    HalfCar {
+        /// Mass of one side frame (kg).
+        mass: f64,
+        /// Pitch inertia of one side frame about its centre (kg m^2).
+        pitch_inertia: f64,
+    },
+}
+
+impl SideFrameSpec {
+    /// The inertia at each axle box, and whether the first two wheelsets share their
+    /// side frames, for the scenario `s`.
+    ///
+    /// Errors: a mass or pitch inertia outside its physical range (named as the FMU
+    /// variables); the half-car's side frames without exactly two wheelsets, or with a
+    /// wheelbase (`wheelset[2].offset`) outside 1 to 5 m.
+    pub fn inertia(&self, s: &Scenario) -> crate::error::Result<(SideFrameInertia, bool)> {
+        use crate::error::out_of_range;
+        match *self {
+            SideFrameSpec::PerWheelset { mass } => {
+                crate::limits::check("vehicle.sideframe.mass", mass)?;
+                Ok((SideFrameInertia::single(mass), false))
+            }
+            SideFrameSpec::HalfCar {
+                mass,
+                pitch_inertia,
+            } => {
+                crate::limits::check("vehicle.sideframe.mass", 0.5 * mass)?;
+                if !(1.0..=1e5).contains(&pitch_inertia) {
+                    return Err(out_of_range(
+                        "vehicle.sideframe.pitch_inertia",
+                        pitch_inertia,
+                        "1 kg m^2 <= vehicle.sideframe.pitch_inertia <= 1e5 kg m^2",
+                    ));
+                }
+                if s.trailing.len() != 1 {
+                    return Err(out_of_range(
+                        "wheelsets",
+                        (s.trailing.len() + 1) as f64,
+                        "2 with vehicle.model = half_car at the axle boxes (the bogie's side \
+                         frames span wheelsets 1 and 2)",
+                    ));
+                }
+                let wheelbase = s.trailing[0].offset;
+                if !(1.0..=5.0).contains(&wheelbase) {
+                    return Err(out_of_range(
+                        "wheelset[2].offset",
+                        wheelbase,
+                        "the half-car bogie's wheelbase, 1 m <= wheelset[2].offset <= 5 m, \
+                         with vehicle.model = half_car at the axle boxes",
+                    ));
+                }
+                Ok((
+                    SideFrameInertia::pitching(mass, pitch_inertia, wheelbase),
+                    true,
+                ))
+            }
         }
     }
 }

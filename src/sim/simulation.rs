@@ -248,6 +248,9 @@ pub struct Simulation {
     pub(super) sites: Vec<Site>,
     /// The half-car bogie that moves the two wheelsets ([`VehicleSpec::HalfCar`]).
     pub(super) bogie: Option<Box<HalfCarBogie>>,
+    /// The first two wheelsets' axle boxes under the same side frames
+    /// ([`crate::sim::SideFrameSpec::HalfCar`]).
+    pub(super) shared_side_frames: bool,
 }
 
 /// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]).
@@ -466,6 +469,10 @@ impl Simulation {
             window = Some(window_spans(p, spec, d_max, s.start_position)?);
         }
         let (dt, critical) = time_step_of(s, &track_spec, &law, static_load)?;
+        let (frame_inertia, shared_side_frames) = match &s.vehicle {
+            VehicleSpec::AxleBox { side_frames, .. } => side_frames.inertia(s)?,
+            _ => (crate::vehicle::SideFrameInertia::single(1.0), false),
+        };
         let vehicle = || -> Result<VehicleState> {
             Ok(match &s.vehicle {
                 VehicleSpec::RollPlane(p) => {
@@ -475,9 +482,9 @@ impl Simulation {
                     VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
                 }
                 VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
-                VehicleSpec::AxleBox { vehicle, .. } => {
-                    VehicleState::AxleBox(crate::vehicle::PrimaryLink::new(vehicle, dt)?)
-                }
+                VehicleSpec::AxleBox { vehicle, .. } => VehicleState::AxleBox(
+                    crate::vehicle::PrimaryLink::new(vehicle, dt, frame_inertia)?,
+                ),
                 VehicleSpec::HalfCar(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
@@ -563,6 +570,7 @@ impl Simulation {
             simd: SimdLevel::detect(),
             sites: Vec::new(),
             bogie,
+            shared_side_frames,
         };
         sim.set_static()?;
         sim.check_static_sag()?;
@@ -1081,6 +1089,9 @@ impl Simulation {
         let lead = self.wheelsets.lead_mut();
         lead.extremes.record(p);
         lead.vehicle.step(p);
+        if self.shared_side_frames {
+            self.share_side_frames();
+        }
         if self.bogie.is_some() {
             self.step_bogie();
         }
@@ -1171,6 +1182,26 @@ impl Simulation {
     /// ([`VehicleSpec::HalfCar`]).
     pub fn bogie(&self) -> Option<&HalfCarBogie> {
         self.bogie.as_deref()
+    }
+
+    /// With the half-car bogie's side frames over the first two wheelsets' axle boxes
+    /// ([`crate::sim::SideFrameSpec::HalfCar`]): each wheelset's primary forces of the
+    /// step into the other's, which they move through the side frames' pitch.
+    #[inline(never)]
+    fn share_side_frames(&mut self) {
+        let last = [0, 1].map(|k| match self.wheelsets.get(k).map(|w| &w.vehicle) {
+            Some(VehicleState::AxleBox(link)) => Some(link.last_force()),
+            _ => None,
+        });
+        if let [Some(a), Some(b)] = last {
+            for (k, f) in [(0, b), (1, a)] {
+                if let Some(VehicleState::AxleBox(link)) =
+                    self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
+                {
+                    link.set_partner_force(f);
+                }
+            }
+        }
     }
 
     /// Advances the half-car bogie one step under the contact forces of its two

@@ -24,7 +24,7 @@ mod roll_plane;
 #[cfg(test)]
 mod tests;
 
-pub use axle_box::{PrimaryLink, SprungBogie, WheelsetBody};
+pub use axle_box::{PrimaryLink, SideFrameInertia, SprungBogie, WheelsetBody};
 pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
 };

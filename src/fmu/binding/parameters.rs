@@ -7,7 +7,7 @@ use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
 use crate::sim::VehicleUnitParams;
-use crate::sim::{Scenario, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
+use crate::sim::{Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
 use crate::track::{RailEnds, RailSection, TrackParams};
 use crate::vehicle::{HalfCarParams, RollPlaneParams};
 use crate::wheel::{FlatShape, FlatSpec};
@@ -165,6 +165,16 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
         _ if axle_box(v) => VehicleSpec::AxleBox {
             vehicle: wheelset_params(v),
+            side_frames: if val(vr::VEHICLE_MODEL) == enums::vehicle_model::HALF_CAR {
+                SideFrameSpec::HalfCar {
+                    mass: 2.0 * val(vr::VEHICLE_SIDEFRAME_MASS),
+                    pitch_inertia: val(vr::VEHICLE_SIDEFRAME_PITCH_INERTIA),
+                }
+            } else {
+                SideFrameSpec::PerWheelset {
+                    mass: val(vr::VEHICLE_SIDEFRAME_MASS),
+                }
+            },
             static_load,
         },
         _ => VehicleSpec::External { static_load },
