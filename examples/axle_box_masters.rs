@@ -21,6 +21,7 @@ use wheelflat::sim::{
 use wheelflat::vehicle::{HalfCarParams, Quad, RollPlaneParams, SprungBogie, SprungHalfCar};
 
 /// The bodies above the primary suspension.
+#[allow(clippy::large_enum_variant)]
 enum Above {
     RollPlane(SprungBogie),
     HalfCar(SprungHalfCar),
