@@ -9,12 +9,14 @@
 //! * sequential (Gauss-Seidel, track first): the bogie steps with the mean force of the
 //!   step the track has just taken;
 //! * Jacobi (OSP libcosim's and ecos' fixed-step algorithms): both step from the same
-//!   communication point, the bogie with the mean force of the step before.
+//!   communication point, the bogie with the primary force at that point
+//!   (`Simulation::primary_force_of`, TrackContact's `primary.*.force`).
 //!
 //! Printed per vehicle, master and step: each wheel's peak error against the monolithic
 //! run (`VehicleSpec::RollPlane`, `VehicleSpec::HalfCar`) and the largest difference of
 //! the contact-force histories over the static load, or where it diverged.
-//! `cargo run --release --example axle_box_masters [duration_s]`
+//! `cargo run --release --example axle_box_masters [duration_s] [--limits]`: with
+//! `--limits`, the largest usable step per master over primary stiffnesses and dampings.
 use wheelflat::sim::{
     Scenario, SideFrameSpec, Simulation, TrackWindow, TrailingWheelset, VehicleSpec,
 };
@@ -58,16 +60,43 @@ fn roll_plane(s: &Scenario) -> RollPlaneParams {
     }
 }
 
-fn main() {
-    let duration: f64 = std::env::args()
-        .nth(1)
-        .map_or(0.6, |a| a.parse().expect("a duration in seconds"));
-    for half_car in [false, true] {
+/// Outcome of one coupled run: the peak errors (%) per wheel and the largest history
+/// difference over the static load (%), or where it failed.
+type Outcome = Result<(Vec<f64>, f64), String>;
+
+/// The reference flat case with `k1` (N/m) and `c1` (N s/m) primary suspensions,
+/// monolithic: its contact forces at every track step, its static load.
+struct Case {
+    half_car: bool,
+    mono: Scenario,
+    cut: Scenario,
+    h_params: HalfCarParams,
+    p: RollPlaneParams,
+    reference: Vec<Quad>,
+    load: f64,
+    duration: f64,
+}
+
+fn record(sim: &Simulation) -> Quad {
+    [0, 1].map(|k| {
+        sim.sample_of(k)
+            .map_or([0.0; 2], |s| [s.contact[0].force, s.contact[1].force])
+    })
+}
+
+fn peaks(f: &[Quad]) -> Quad {
+    [0, 1].map(|k| [0, 1].map(|s| f.iter().map(|q| q[k][s]).fold(f64::MIN, f64::max)))
+}
+
+impl Case {
+    fn new(half_car: bool, k1: f64, c1: f64, duration: f64) -> Case {
         let mut mono = Scenario::table_4_4_flat();
         mono.window = Some(TrackWindow::DEFAULT);
-        let p = roll_plane(&mono);
-        let wheelbase = 1.8;
-        let pitch_inertia = 180.0;
+        let mut p = roll_plane(&mono);
+        p.primary_stiffness = k1;
+        p.primary_damping = c1;
+        mono.vehicle = VehicleSpec::RollPlane(p);
+        let (wheelbase, pitch_inertia) = (1.8, 180.0);
         let h_params = HalfCarParams::from_roll_plane(&p, wheelbase, pitch_inertia);
         if half_car {
             mono.vehicle = VehicleSpec::HalfCar(h_params);
@@ -76,39 +105,13 @@ fn main() {
                 ..Default::default()
             }];
         }
-        let wheelsets = if half_car { 2 } else { 1 };
         let mut whole = Simulation::new(&mono).unwrap();
-        let mut reference: Vec<Quad> = Vec::new();
-        let record = |sim: &Simulation| -> Quad {
-            [0, 1].map(|k| {
-                sim.sample_of(k)
-                    .map_or([0.0; 2], |s| [s.contact[0].force, s.contact[1].force])
-            })
-        };
         let steps = (duration / whole.dt()).round() as usize;
+        let mut reference = Vec::with_capacity(steps);
         for _ in 0..steps {
             whole.step().unwrap();
             reference.push(record(&whole));
         }
-        let load = whole.static_load()[0];
-        let peaks = |f: &[Quad]| -> Quad {
-            [0, 1].map(|k| [0, 1].map(|s| f.iter().map(|q| q[k][s]).fold(f64::MIN, f64::max)))
-        };
-        let ref_peaks = peaks(&reference);
-        println!(
-            "{}: monolithic peaks {} kN",
-            if half_car {
-                "half-car bogie"
-            } else {
-                "roll-plane vehicle"
-            },
-            (0..wheelsets)
-                .flat_map(|k| ref_peaks[k].map(|x| format!("{:.2}", x / 1e3)))
-                .collect::<Vec<_>>()
-                .join(" / ")
-        );
-        println!("| master | step | peak errors (%) | history / static load (%) |");
-        println!("|---|---|---|---|");
         let mut cut = mono.clone();
         cut.vehicle = VehicleSpec::AxleBox {
             vehicle: p,
@@ -124,86 +127,165 @@ fn main() {
             },
             static_load: [p.static_wheel_load(); 2],
         };
+        Case {
+            half_car,
+            load: whole.static_load()[0],
+            mono,
+            cut,
+            h_params,
+            p,
+            reference,
+            duration,
+        }
+    }
+
+    fn wheelsets(&self) -> usize {
+        if self.half_car { 2 } else { 1 }
+    }
+
+    /// The cut model at communication step `h` (s) under a Jacobi or sequential master.
+    fn run(&self, jacobi: bool, h: f64) -> Outcome {
+        let mut sim = Simulation::new(&self.cut).map_err(|e| e.to_string())?;
+        let dt = sim.dt();
+        let per = (h / dt).round().max(1.0) as u64;
+        let h = per as f64 * dt;
+        let critical = if self.half_car {
+            self.h_params.critical_time_step()
+        } else {
+            self.p.critical_time_step()
+        };
+        let sub = (h / (5e-4f64).min(0.4 * critical)).ceil() as usize;
+        let hs = h / sub as f64;
+        let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
+        let mut above = if self.half_car {
+            let mut b = SprungHalfCar::new(self.h_params, hs).map_err(|e| e.to_string())?;
+            b.set_static(boxes).unwrap();
+            Above::HalfCar(b)
+        } else {
+            let mut b = SprungBogie::new(self.p, hs).map_err(|e| e.to_string())?;
+            b.set_static(boxes[0]).unwrap();
+            Above::RollPlane(b)
+        };
+        let primary = |sim: &Simulation| -> Quad {
+            [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.0))
+        };
+        let mut f: Vec<Quad> = Vec::with_capacity(self.reference.len());
+        for _ in 0..(self.duration / h).round() as usize {
+            // A Jacobi master hands the bogie the outputs of the communication point
+            // both start from; a sequential one the track's mean of the step just taken.
+            let held = [0, 1].map(|k| sim.primary_force_of(k).unwrap_or([0.0; 2]));
+            let (zs, vs) = above.side_frames();
+            for k in 0..self.wheelsets() {
+                sim.set_side_frames_of(k, zs[k], vs[k])
+                    .map_err(|e| format!("at {:.3} s: {e}", f.len() as f64 * dt))?;
+            }
+            for _ in 0..per {
+                sim.step()
+                    .map_err(|e| format!("at {:.3} s: {e}", f.len() as f64 * dt))?;
+                f.push(record(&sim));
+            }
+            let force = if jacobi { held } else { primary(&sim) };
+            for _ in 0..sub {
+                above.step(force);
+            }
+            if above.diverged() {
+                return Err(format!(
+                    "the bogie diverged at {:.3} s",
+                    f.len() as f64 * dt
+                ));
+            }
+        }
+        let n = f.len().min(self.reference.len());
+        let mut diff: f64 = 0.0;
+        for (a, b) in f[..n].iter().zip(&self.reference) {
+            for k in 0..self.wheelsets() {
+                for s in 0..2 {
+                    diff = diff.max((a[k][s] - b[k][s]).abs());
+                }
+            }
+        }
+        let (pk, rp) = (peaks(&f), peaks(&self.reference));
+        let errs = (0..self.wheelsets())
+            .flat_map(|k| [0, 1].map(|s| 100.0 * (pk[k][s] / rp[k][s] - 1.0)))
+            .collect();
+        Ok((errs, 100.0 * diff / self.load))
+    }
+
+    /// The largest communication step (s) up to 20 ms below which every step of a
+    /// geometric scan (ratio 1.1 from 0.1 ms) keeps the run usable: the history
+    /// within 10 % of the static load.
+    fn limit(&self, jacobi: bool) -> f64 {
+        let usable = |h: f64| matches!(self.run(jacobi, h), Ok((_, d)) if d < 10.0);
+        let mut h = 1e-4;
+        while h <= 20e-3 {
+            if !usable(h * 1.1) {
+                return h;
+            }
+            h *= 1.1;
+        }
+        h
+    }
+}
+
+fn main() {
+    let duration: f64 = std::env::args()
+        .nth(1)
+        .map_or(0.6, |a| a.parse().expect("a duration in seconds"));
+    let limits = std::env::args().any(|a| a == "--limits");
+    let d = roll_plane(&Scenario::table_4_4_flat());
+    for half_car in [false, true] {
+        let name = if half_car {
+            "half-car bogie"
+        } else {
+            "roll-plane vehicle"
+        };
+        if limits {
+            println!("{name}: largest usable communication step (ms), {duration} s");
+            println!("| K_1 (MN/m) | C_1 (kN s/m) | sequential | Jacobi |");
+            println!("|---|---|---|---|");
+            for k1 in [d.primary_stiffness, 1e8, 7.88e8, 1e10] {
+                for c1 in [0.0, d.primary_damping, 1e6] {
+                    let case = Case::new(half_car, k1, c1, duration);
+                    println!(
+                        "| {} | {} | {:.2} | {:.2} |",
+                        k1 / 1e6,
+                        c1 / 1e3,
+                        case.limit(false) * 1e3,
+                        case.limit(true) * 1e3
+                    );
+                }
+            }
+            continue;
+        }
+        let case = Case::new(half_car, d.primary_stiffness, d.primary_damping, duration);
+        let rp = peaks(&case.reference);
+        let _ = &case.mono;
+        println!(
+            "{name}: monolithic peaks {} kN",
+            (0..case.wheelsets())
+                .flat_map(|k| rp[k].map(|x| format!("{:.2}", x / 1e3)))
+                .collect::<Vec<_>>()
+                .join(" / ")
+        );
+        println!("| master | step | peak errors (%) | history / static load (%) |");
+        println!("|---|---|---|---|");
         for jacobi in [false, true] {
+            let master = if jacobi { "Jacobi" } else { "sequential" };
             for h in [0.5e-3, 1e-3, 2e-3, 3e-3, 4e-3, 6e-3] {
-                let mut sim = Simulation::new(&cut).unwrap();
-                let dt = sim.dt();
-                let per = (h / dt).round().max(1.0) as u64;
-                let h = per as f64 * dt;
-                let sub = (h / 5e-4).ceil() as usize;
-                let hs = h / sub as f64;
-                let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
-                let mut above = if half_car {
-                    let mut b = SprungHalfCar::new(h_params, hs).unwrap();
-                    b.set_static(boxes).unwrap();
-                    Above::HalfCar(b)
-                } else {
-                    let mut b = SprungBogie::new(p, hs).unwrap();
-                    b.set_static(boxes[0]).unwrap();
-                    Above::RollPlane(b)
-                };
-                let mut f: Vec<Quad> = Vec::new();
-                let mut failed = None;
-                let primary = |sim: &Simulation| -> Quad {
-                    [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.0))
-                };
-                'run: for _ in 0..(duration / h).round() as usize {
-                    // What the bogie takes: a Jacobi master hands it the outputs of the
-                    // communication point both start from.
-                    let held = primary(&sim);
-                    let (zs, vs) = above.side_frames();
-                    for k in 0..wheelsets {
-                        sim.set_side_frames_of(k, zs[k], vs[k]).unwrap();
-                    }
-                    for _ in 0..per {
-                        if let Err(e) = sim.step() {
-                            failed = Some(format!("{e}"));
-                            break 'run;
-                        }
-                        f.push(record(&sim));
-                    }
-                    let force = if jacobi { held } else { primary(&sim) };
-                    for _ in 0..sub {
-                        above.step(force);
-                    }
-                    if above.diverged() {
-                        failed = Some("the bogie diverged".into());
-                        break;
-                    }
-                }
-                let master = if jacobi { "Jacobi" } else { "sequential" };
-                let n = f.len().min(reference.len());
-                let mut diff: f64 = 0.0;
-                for (a, b) in f[..n].iter().zip(&reference) {
-                    for k in 0..wheelsets {
-                        for s in 0..2 {
-                            diff = diff.max((a[k][s] - b[k][s]).abs());
-                        }
-                    }
-                }
-                match failed {
-                    Some(e) => println!(
-                        "| {master} | {:.1} ms | unstable at {:.3} s: {} | |",
+                match case.run(jacobi, h) {
+                    Err(e) => println!(
+                        "| {master} | {:.1} ms | unstable {} | |",
                         h * 1e3,
-                        n as f64 * dt,
-                        &e[..e.len().min(70)]
+                        &e[..e.len().min(80)]
                     ),
-                    None => {
-                        let pk = peaks(&f);
-                        let errs: Vec<String> = (0..wheelsets)
-                            .flat_map(|k| {
-                                [0, 1].map(|s| {
-                                    format!("{:+.2}", 100.0 * (pk[k][s] / ref_peaks[k][s] - 1.0))
-                                })
-                            })
-                            .collect();
-                        println!(
-                            "| {master} | {:.1} ms | {} | {:.2} |",
-                            h * 1e3,
-                            errs.join(" / "),
-                            100.0 * diff / load
-                        )
-                    }
+                    Ok((errs, diff)) => println!(
+                        "| {master} | {:.1} ms | {} | {diff:.2} |",
+                        h * 1e3,
+                        errs.iter()
+                            .map(|e| format!("{e:+.2}"))
+                            .collect::<Vec<_>>()
+                            .join(" / ")
+                    ),
                 }
             }
         }

@@ -347,6 +347,17 @@ impl Simulation {
         }
     }
 
+    /// The primary forces `[left, right]` (N) of wheelset `k` at the current time
+    /// (the axle-box interface: the wheelset's and the side frames' motion now), what a
+    /// master that steps every unit from the same point hands the bogie; `None` for a
+    /// wheelset without the axle-box interface.
+    pub fn primary_force_of(&self, k: usize) -> Option<[f64; 2]> {
+        match &self.wheelsets.get(k)?.vehicle {
+            VehicleState::AxleBox(link) => Some(link.force_now()),
+            _ => None,
+        }
+    }
+
     /// The primary suspension of wheelset `k`: its forces `[left, right]` (N, pressing
     /// the wheelset down) averaged over the steps since the side frames were last set
     /// (the impulse the bogie takes over its communication step), and the axle boxes'

@@ -344,8 +344,9 @@ impl PrimaryLink {
         self.partner = f;
     }
 
-    /// The primary forces `[left, right]` (N) at the current state.
-    fn forces_now(&self) -> [f64; 2] {
+    /// The primary forces `[left, right]` (N) at the current state: the wheelset's and
+    /// the side frames' displacements and velocities now.
+    pub fn force_now(&self) -> [f64; 2] {
         let (zb, vb) = (self.body.wheel_z(), self.body.box_velocity());
         [0, 1].map(|i| {
             self.stiffness * (zb[i] - self.now_z[i]) + self.damping * (vb[i] - self.now_v[i])
@@ -356,7 +357,7 @@ impl PrimaryLink {
     /// the current state before the first step.
     pub fn mean_force(&self) -> [f64; 2] {
         if self.steps == 0 {
-            return self.forces_now();
+            return self.force_now();
         }
         let n = self.steps as f64;
         [self.force_sum[0] / n, self.force_sum[1] / n]
@@ -368,7 +369,7 @@ impl PrimaryLink {
     /// load from above.
     #[inline(always)]
     pub fn step(&mut self, p: [f64; 2]) {
-        let f = self.forces_now();
+        let f = self.force_now();
         let (zb, vb) = (self.body.wheel_z(), self.body.box_velocity());
         self.body.step(p, f);
         let dt = self.body.dt;

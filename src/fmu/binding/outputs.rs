@@ -135,8 +135,8 @@ impl FmuModel {
                 }
             }
         };
-        // The primary forces: the vehicle's, the axle-box interface's mean since the
-        // last input, or 0 where the track carries no primary suspension (TrackContact
+        // The primary forces: the vehicle's, the axle-box interface's at the
+        // communication point, or 0 where the track carries no primary suspension (TrackContact
         // with the contact interface).
         let bearing = || match view {
             View::Vehicle(u) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
@@ -144,10 +144,18 @@ impl FmuModel {
                 match (sim.bogie(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
                     (Some(b), _) => b.bearing_forces()[index.min(1)][side],
                     (None, Some(VehicleState::RollPlane(v))) => v.bearing_forces()[side],
-                    (None, Some(VehicleState::AxleBox(link))) => link.mean_force()[side],
+                    (None, Some(VehicleState::AxleBox(link))) => link.force_now()[side],
                     _ => 0.0,
                 }
             }
+        };
+        // The axle-box interface's primary forces averaged since the last input.
+        let mean_bearing = || match view {
+            View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                Some(VehicleState::AxleBox(link)) => link.mean_force()[side],
+                _ => 0.0,
+            },
+            View::Vehicle(_) => 0.0,
         };
         let extremes = |sim: &Simulation| {
             sim.wheelsets()
@@ -204,6 +212,7 @@ impl FmuModel {
             Quantity::WheelsetZ | Quantity::Z => body(4),
             Quantity::WheelsetRoll | Quantity::Roll => body(5),
             Quantity::PrimaryForce => bearing(),
+            Quantity::PrimaryMeanForce => mean_bearing(),
             // Observation points: `site_value` above.
             Quantity::SiteRailZ
             | Quantity::SiteRailZMax
