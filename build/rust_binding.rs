@@ -281,10 +281,47 @@ fn var_spec(rust: &mut String, table: &Table, id: &str, v: &FmuVar) {
         "input" => "Input",
         _ => "Output",
     };
+    // Only an input of an FMU that has the selector is refused in another
+    // configuration (the table tags a shared variable once for all its FMUs).
+    let fmu_has = |name: &str| {
+        table
+            .fmus
+            .iter()
+            .find(|f| f.id() == id)
+            .is_some_and(|f| f.vars.iter().any(|x| x.name() == name))
+    };
+    let cond = v
+        .get("usedWhen")
+        .filter(|c| v.causality() == "input" && fmu_has(c.split('=').next().unwrap_or("")));
+    let used_when = match cond {
+        None => "None".to_string(),
+        Some(cond) => {
+            let (selector, item) = cond
+                .split_once('=')
+                .unwrap_or_else(|| panic!("{id}: {} usedWhen={cond}: `name=item`", v.name()));
+            let (sel, ty) = table
+                .vars
+                .iter()
+                .enumerate()
+                .find(|(_, t)| t.name() == selector)
+                .map(|(i, t)| (i, t.attrs.get("declaredType").cloned()))
+                .unwrap_or_else(|| panic!("{id}: usedWhen names no variable {selector}"));
+            let ty = ty.unwrap_or_else(|| panic!("usedWhen: {selector} is no enumeration"));
+            let value = table.enums[&ty]
+                .iter()
+                .find(|x| x.name == item)
+                .unwrap_or_else(|| panic!("usedWhen: {item} is no item of {ty}"))
+                .value;
+            format!(
+                "Some(UsedWhen {{ selector: {sel}, value: {value}.0, text: {:?} }})",
+                format!("{selector} = {item} ({value})")
+            )
+        }
+    };
     writeln!(
         rust,
         "        VarSpec {{ vr: {}, name: {:?}, ty: VarType::{ty}, causality: Causality::{causality}, \
-         start: {}, min: {lo}, max: {hi}, unit: {:?} }},",
+         start: {}, min: {lo}, max: {hi}, unit: {:?}, used_when: {used_when} }},",
         v.vr,
         v.name(),
         num("start", "f64::NAN"),

@@ -44,6 +44,21 @@ pub struct VarSpec {
     pub max: f64,
     /// Unit (empty for integers).
     pub unit: &'static str,
+    /// An input used only in one configuration of the FMU (the table's `usedWhen`):
+    /// setting it in another is refused.
+    pub used_when: Option<UsedWhen>,
+}
+
+/// The configuration an input belongs to: the parameter `selector` (a value reference)
+/// has the value `value`; `text` says it in words (`interface = axle_box`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UsedWhen {
+    /// Value reference of the parameter that selects the configuration.
+    pub selector: u32,
+    /// The selector's value for this configuration.
+    pub value: f64,
+    /// The condition in words, with the selector's name: `interface = axle_box (2)`.
+    pub text: &'static str,
 }
 
 /// One FMU: identity, its modelDescription.xml and its variables.
@@ -69,7 +84,7 @@ pub struct FmuTable {
 // Start values are the table's literal numbers (pi/2 among them).
 #[allow(clippy::approx_constant)]
 mod generated {
-    use super::{Causality, FmuTable, VarSpec, VarType};
+    use super::{Causality, FmuTable, UsedWhen, VarSpec, VarType};
     include!(concat!(env!("OUT_DIR"), "/variables.rs"));
 }
 pub use generated::*;

@@ -422,19 +422,22 @@ impl Model for FmuModel {
     /// where the end's reflections raise the impact forces (by 20 to 35 % within the
     /// last span, table 4.4); for the vehicles with the axle-box interface, a
     /// communication step above [`VehicleUnit::axle_box_step_limit`].
-    fn step_warning(&self, time: f64) -> Option<String> {
+    fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
         if let Engine::Vehicle(u) = &self.engine {
             let limit = u.axle_box_step_limit()?;
             return (self.last_step > limit).then(|| {
-                format!(
-                    "at t = {time} s the communication step {} s is above about {} s, the \
+                (
+                    "axle-box step",
+                    format!(
+                        "at t = {time} s the communication step {} s is above about {} s, the \
                      largest at which the axle-box interface's exchange of the primary forces \
                      stays stable (the primary dampers against the side frames: 2 m / C_1, \
                      for the half-car bogie 2 J / (2 C_1 (wheelbase/2)^2) with J = \
                      vehicle.sideframe.pitch_inertia): expect it to diverge; use shorter \
                      steps",
-                    num(self.last_step),
-                    num(limit)
+                        num(self.last_step),
+                        num(limit)
+                    ),
                 )
             });
         }
@@ -448,13 +451,13 @@ impl Model for FmuModel {
         let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
         let x = sim.position();
         (x > zone).then(|| {
-            format!(
+            ("rail end", format!(
                 "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans \
                  of the fixed rail end at {:.3} m: the end's reflections raise impact forces \
                  here (by 20 to 35 % within the last span); keep the impacts of interest at \
                  least {END_ZONE_SPANS} spans from the ends (track.spans)",
                 p.length()
-            )
+            ))
         })
     }
 

@@ -35,9 +35,9 @@ pub struct Instance<M: Model> {
     /// Why the run cannot go on (a value beyond the health bounds): `fmi2DoStep` and
     /// outputs are refused until `fmi2Reset` or `fmi2SetFMUstate`.
     pub(super) failed: Option<String>,
-    /// The run's step warning ([`Model::step_warning`]) was logged: once per run, until
-    /// `fmi2Reset` (FMU states leave it as it is).
-    pub(super) step_warned: bool,
+    /// The kinds of step warning ([`Model::step_warning`]) logged: each once per run,
+    /// until `fmi2Reset` (FMU states leave them as they are).
+    pub(super) step_warned: Vec<&'static str>,
     logger: Logger,
     logging_on: bool,
     categories: [bool; 4],
@@ -79,7 +79,7 @@ impl<M: Model> Instance<M> {
             stop_time: None,
             ended: false,
             failed: None,
-            step_warned: false,
+            step_warned: Vec::new(),
             logger,
             logging_on,
             categories: [true; 4],
@@ -292,6 +292,16 @@ impl<M: Model> Instance<M> {
     /// `fmi2ExitInitializationMode`: builds the model if parameters changed.
     pub fn exit_initialization(&mut self) -> FmiResult {
         self.check(Call::ExitInitializationMode)?;
+        // Inputs set for another configuration than the one now fixed.
+        let misused = self
+            .table
+            .vars
+            .iter()
+            .filter(|v| self.given[v.vr as usize])
+            .find_map(|v| self.unused_input(v));
+        if let Some(why) = misused {
+            return self.refuse(Status::Error, format!("fmi2ExitInitializationMode: {why}"));
+        }
         self.ensure_model()?;
         self.phase = Phase::StepComplete;
         self.log_event(|| "initialised in static equilibrium".into());
@@ -300,7 +310,13 @@ impl<M: Model> Instance<M> {
             .as_ref()
             .and_then(|m| m.initialised_warning(self.start_time, self.stop_time));
         if let Some(w) = warning {
-            self.warn(&format!("fmi2ExitInitializationMode: {w}"));
+            // Initialised: the warning is the status, nothing was refused.
+            let message = format!("fmi2ExitInitializationMode: {w}");
+            self.warn(&message);
+            return Err(Refusal {
+                status: Status::Warning,
+                message,
+            });
         }
         Ok(())
     }
@@ -326,7 +342,7 @@ impl<M: Model> Instance<M> {
         self.stop_time = None;
         self.ended = false;
         self.failed = None;
-        self.step_warned = false;
+        self.step_warned.clear();
         self.calculated = vec![0.0; M::CALCULATED];
         Ok(())
     }

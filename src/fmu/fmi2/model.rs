@@ -102,8 +102,10 @@ pub trait Model: Clone + Sized {
     fn step_fault(e: &Error) -> StepFault;
 
     /// A warning about the state after a successful step at the communication time
-    /// `time` (s). The instance logs the first one of a run only (until `fmi2Reset`).
-    fn step_warning(&self, time: f64) -> Option<String>;
+    /// `time` (s): its kind (a short fixed name) and the message. `fmi2DoStep` returns
+    /// `fmi2Warning` after every step the condition holds and logs the message the
+    /// first time of each kind in a run (until `fmi2Reset`).
+    fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)>;
 
     /// Everything that determines the continuation, for serialized FMU states.
     fn state_vector(&self) -> Result<Vec<f64>, Error>;

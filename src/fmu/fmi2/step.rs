@@ -105,12 +105,18 @@ impl<M: Model> Instance<M> {
             return self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
-        if !self.step_warned {
-            let warning = self.model.as_ref().and_then(|m| m.step_warning(end));
-            if let Some(w) = warning {
-                self.step_warned = true;
-                self.warn(&format!("fmi2DoStep: {w}"));
+        let warning = self.model.as_mut().and_then(|m| m.step_warning(end));
+        if let Some((kind, w)) = warning {
+            // The step was taken: the warning is the status, logged once per kind.
+            let message = format!("fmi2DoStep: {w}");
+            if !self.step_warned.contains(&kind) {
+                self.step_warned.push(kind);
+                self.warn(&message);
             }
+            return Err(super::status::Refusal {
+                status: Status::Warning,
+                message,
+            });
         }
         Ok(())
     }

@@ -113,6 +113,29 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
+    /// Why input `s` is not used in the FMU's configuration (its table's `usedWhen`
+    /// does not hold), in words; `None` when it is used.
+    pub(super) fn unused_input(&self, s: &VarSpec) -> Option<String> {
+        let w = s.used_when?;
+        let now = self.values[w.selector as usize];
+        (now != w.value).then(|| {
+            let selector = self
+                .table
+                .vars
+                .iter()
+                .find(|v| v.vr == w.selector)
+                .map_or("the selector", |v| v.name);
+            format!(
+                "`{}` is an input of {} only, but {selector} = {} here, where it would be \
+                 ignored: connect the inputs of the {selector} in use, or set {selector} to \
+                 match the coupling",
+                s.name,
+                w.text,
+                num(now)
+            )
+        })
+    }
+
     /// Writes variables (Real or Integer/Enumeration by `real`): every value is checked
     /// before any is stored, so a refused call changes nothing.
     fn set(&mut self, call: Call, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
@@ -149,6 +172,14 @@ impl<M: Model> Instance<M> {
                         }
                     ),
                 );
+            }
+            // An input of another configuration: refused once the configuration is
+            // fixed (after initialisation); before, the selector may still change, and
+            // fmi2ExitInitializationMode checks what was set.
+            if !matches!(self.phase, Phase::Instantiated | Phase::Initialization)
+                && let Some(why) = self.unused_input(s)
+            {
+                return self.refuse(Status::Error, format!("{call}: {why}"));
             }
             if !x.is_finite() || x < s.min || x > s.max {
                 let unit = if s.unit.is_empty() {

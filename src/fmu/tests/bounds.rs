@@ -103,7 +103,11 @@ fn an_unreachable_stop_time_is_named_at_initialisation() {
     let (mut i, log) = instance(Kind::CoupledSystem);
     i.setup_experiment(0.0, Some(2.0)).unwrap();
     i.enter_initialization().unwrap();
-    i.exit_initialization().unwrap();
+    // Initialised, with the warning as the status.
+    let w = i.exit_initialization().unwrap_err();
+    assert_eq!(w.status, Status::Warning);
+    assert!(w.message.contains("stopTime = 2 s cannot be reached"));
+    i.do_step(0.0, 1e-3).unwrap();
     let log = log.lock().unwrap();
     assert_eq!(log.len(), 1);
     // 30 spans of 0.685 m from 1.37 m at 70 km/h: the end at 0.986 s; 2 s needs
@@ -329,7 +333,7 @@ fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
 }
 
 #[test]
-fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
+fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_per_run() {
     let (mut i, log) = instance(Kind::CoupledSystem);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
@@ -350,10 +354,16 @@ fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
     }
     assert_eq!(warnings(&log), 0, "not yet in the zone at {t} s");
     let before = i.get_state().unwrap();
+    // Every step in the zone returns fmi2Warning (the step is taken); the message is
+    // logged once.
+    let mut statuses = Vec::new();
     while t < 0.93 - 1e-9 {
-        i.do_step(t, h).unwrap();
+        statuses.push(i.do_step(t, h).map_err(|r| r.status));
         t = i.time();
     }
+    // The zone from 0.916 s: the step that ends at 0.916 s is the 16th.
+    assert!(statuses[..15].iter().all(|s| s.is_ok()), "{statuses:?}");
+    assert!(statuses[15..].iter().all(|s| *s == Err(Status::Warning)), "{statuses:?}");
     assert_eq!(warnings(&log), 1);
     let after = i.get_state().unwrap();
     let bytes = i.serialize(&after).unwrap();
@@ -363,7 +373,7 @@ fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
     for s in [&after, &restored, &before] {
         i.set_state(s).unwrap();
         let t = i.time();
-        i.do_step(t, 0.02).unwrap();
+        assert_eq!(i.do_step(t, 0.02).unwrap_err().status, Status::Warning);
         assert_eq!(warnings(&log), 1);
     }
     // A new run warns again.
@@ -372,7 +382,7 @@ fn the_track_end_warning_is_given_once_per_run_whatever_states_are_restored() {
     i.exit_initialization().unwrap();
     i.set_state(&restored).unwrap();
     let t = i.time();
-    i.do_step(t, h).unwrap();
+    assert_eq!(i.do_step(t, h).unwrap_err().status, Status::Warning);
     assert_eq!(warnings(&log), 2);
 }
 
