@@ -86,6 +86,10 @@ pub struct VehicleUnit {
     /// vehicle.
     force: Quad,
     extremes: [ForceExtremes; 2],
+    /// The axle rotation (rad) at `since` (s), from which it turns at the speed held
+    /// since ([`VehicleUnit::set_speed`]).
+    rotation_ref: f64,
+    since: f64,
 }
 
 impl VehicleUnit {
@@ -170,6 +174,8 @@ impl VehicleUnit {
             clock: Clock::new(dt, Stepping::Substeps),
             force,
             extremes: force.map(ForceExtremes::at),
+            rotation_ref: 0.0,
+            since: 0.0,
         };
         unit.check_states()?;
         Ok(unit)
@@ -207,9 +213,32 @@ impl VehicleUnit {
     pub fn carried(&self) -> f64 {
         self.clock.carried
     }
-    /// Axle rotation angle `V t / R_w` (rad) (2.17).
+    /// Axle rotation angle (rad) (2.17): `V t / R_w` at a constant speed, and in
+    /// general the rotation at the last change of speed plus `V (t - t_change) / R_w`.
     pub fn rotation(&self) -> f64 {
-        self.params.speed * self.time() / self.params.wheel_radius
+        self.rotation_ref
+            + self.params.speed * (self.time() - self.since) / self.params.wheel_radius
+    }
+
+    /// Forward speed `V` (m/s).
+    pub fn speed(&self) -> f64 {
+        self.params.speed
+    }
+
+    /// Sets the forward speed `V` (m/s), held from now on: the axle turns on from the
+    /// rotation reached at `V / R_w`, as the track's motion does
+    /// ([`crate::sim::Simulation::set_speed`]).
+    ///
+    /// Errors: `V` outside its physical range ([`crate::limits::check`]); nothing
+    /// changes then.
+    pub fn set_speed(&mut self, v: f64) -> Result<()> {
+        check("speed", v)?;
+        if v != self.params.speed {
+            self.rotation_ref = self.rotation();
+            self.since = self.time();
+            self.params.speed = v;
+        }
+        Ok(())
     }
     /// Wheel-centre displacements `[left, right]` (m) of the leading wheelset.
     pub fn wheel_z(&self) -> [f64; 2] {
@@ -588,20 +617,29 @@ impl VehicleUnit {
         }
     }
 
-    /// Values ahead of the body's in a state vector: the clock (3), then per wheelset
-    /// the held forces (2) and the extremes.
+    /// Values ahead of the body's in a state vector: the clock (3), the motion (speed,
+    /// rotation at the last change of speed, its time), then per wheelset the held
+    /// forces (2) and the extremes.
     fn head_len(&self) -> usize {
-        3 + self.wheelsets() * (2 + ForceExtremes::LEN)
+        6 + self.wheelsets() * (2 + ForceExtremes::LEN)
     }
 
     /// Everything that determines the continuation: the clock (`t0` (s), `k`, the
-    /// carried time (s)), the held forces `[left, right]` (N) of each wheelset, the
+    /// carried time (s)), the motion (the speed (m/s), the rotation (rad) at its last
+    /// change and that time (s)), the held forces `[left, right]` (N) of each wheelset, the
     /// largest and smallest forces `[left, right]` (N) of each, then the vehicle's step
     /// and displacements; [`VehicleUnit::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let c = &self.clock;
         let n = self.wheelsets();
-        let mut v = vec![c.t0, c.k as f64, c.carried];
+        let mut v = vec![
+            c.t0,
+            c.k as f64,
+            c.carried,
+            self.params.speed,
+            self.rotation_ref,
+            self.since,
+        ];
         v.extend(self.force[..n].iter().flatten());
         for e in &self.extremes[..n] {
             v.extend(e.to_array());
@@ -636,7 +674,15 @@ impl VehicleUnit {
                  below the least step",
             ));
         }
-        for &f in &v[3..head] {
+        if check("speed", v[3]).is_err() || !v[4].is_finite() || !(v[5].is_finite() && v[5] >= 0.0)
+        {
+            return Err(out_of_range(
+                "state: motion",
+                v[3],
+                "a speed in its range, a finite rotation, a time of change >= 0 s",
+            ));
+        }
+        for &f in &v[6..head] {
             if !within(f, 1e7) {
                 return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
             }
@@ -660,10 +706,13 @@ impl VehicleUnit {
         self.clock.t0 = v[0];
         self.clock.k = v[1] as u64;
         self.clock.carried = v[2];
+        self.params.speed = v[3];
+        self.rotation_ref = v[4];
+        self.since = v[5];
         let n = self.wheelsets();
         for k in 0..n {
-            self.force[k] = [v[3 + 2 * k], v[4 + 2 * k]];
-            let e = 3 + 2 * n + ForceExtremes::LEN * k;
+            self.force[k] = [v[6 + 2 * k], v[7 + 2 * k]];
+            let e = 6 + 2 * n + ForceExtremes::LEN * k;
             self.extremes[k] = ForceExtremes::from_slice(&v[e..e + ForceExtremes::LEN]);
         }
         self.check_states()

@@ -275,6 +275,9 @@ impl Model for FmuModel {
                 Ok(())
             }
             (Engine::Vehicle(u), _) => {
+                if changed.contains(&vr::SPEED) {
+                    u.set_speed(v(vr::SPEED))?;
+                }
                 let refs = if u.is_axle_box() {
                     VEHICLE_AXLE_BOX_VRS
                 } else {

@@ -363,7 +363,10 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
     }
     // The zone from 0.916 s: the step that ends at 0.916 s is the 16th.
     assert!(statuses[..15].iter().all(|s| s.is_ok()), "{statuses:?}");
-    assert!(statuses[15..].iter().all(|s| *s == Err(Status::Warning)), "{statuses:?}");
+    assert!(
+        statuses[15..].iter().all(|s| *s == Err(Status::Warning)),
+        "{statuses:?}"
+    );
     assert_eq!(warnings(&log), 1);
     let after = i.get_state().unwrap();
     let bytes = i.serialize(&after).unwrap();
