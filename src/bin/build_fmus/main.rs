@@ -2,7 +2,9 @@
 //! modelDescription.xml, the crate's shared library as
 //! `binaries/<platform>/<modelIdentifier>.so` and the generated
 //! `documentation/index.html` (build/documentation.rs); writes the C header of the
-//! exported functions to `fmu/include/wheelflat_fmi2.h`.
+//! exported functions to `fmu/include/wheelflat_fmi2.h`; then the system structures of
+//! TrackContact with each vehicle under `fmu/systems/` (SSP archives and OSP system
+//! structures, generated from the variable table: systems.rs).
 //!
 //! Run after `cargo build --release` (the shared library must sit next to this
 //! executable): `cargo build --release && cargo run --release --bin build_fmus [OUT_DIR
@@ -10,6 +12,7 @@
 //! from the table there (`docs/VARIABLES.md`).
 
 mod icons;
+mod systems;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -142,5 +145,6 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         z.finish()?;
         println!("{} ({} {})", path.display(), t.model_identifier, t.guid);
     }
+    systems::write(&out)?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! ([`Kind`]), the engine's parameters from its variables, its outputs, and the
 //! [`FmuModel`] that implements [`crate::fmu::fmi2::Model`].
 
+mod datum;
 mod outputs;
 mod parameters;
 mod unit;

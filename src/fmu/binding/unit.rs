@@ -3,11 +3,14 @@
 //! outputs, and the state vector of FMU states.
 
 use super::Kind;
+use super::datum::InputDatum;
 use super::outputs::Published;
 use super::parameters::{scenario, vehicle_unit_params};
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
-use crate::fmu::vars::{FmuTable, TRAILING, TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, VarSpec, vr};
+use crate::fmu::vars::{
+    FmuTable, TRAILING, TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, VarSpec, enums, vr,
+};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
 use crate::sim::{Sample, Simulation, TrackSpec, VehicleState, VehicleUnit};
 
@@ -44,24 +47,25 @@ const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
 ];
 
 /// Hands wheelset `k` of `sim` its wheel inputs `[left z, right z, rotation]` (value
-/// references) among `changed`, from `values`.
+/// references) among `changed`: the heights `z` (m, measured from the datum), the
+/// rotation from `values`.
 #[inline(always)]
 fn wheel_inputs(
     sim: &mut Simulation,
     k: usize,
     [left, right, rotation]: [u32; 3],
+    z: [f64; 2],
     values: &[f64],
     changed: &[u32],
 ) -> Result<(), Error> {
-    let v = |r: u32| values[r as usize];
     match (changed.contains(&left), changed.contains(&right)) {
-        (true, true) => sim.set_wheel_z_of(k, [v(left), v(right)])?,
-        (true, false) => sim.set_wheel_side_z_of(k, 0, v(left))?,
-        (false, true) => sim.set_wheel_side_z_of(k, 1, v(right))?,
+        (true, true) => sim.set_wheel_z_of(k, z)?,
+        (true, false) => sim.set_wheel_side_z_of(k, 0, z[0])?,
+        (false, true) => sim.set_wheel_side_z_of(k, 1, z[1])?,
         (false, false) => {}
     }
     if changed.contains(&rotation) {
-        sim.set_rotation_of(k, v(rotation))?;
+        sim.set_rotation_of(k, values[rotation as usize])?;
     }
     Ok(())
 }
@@ -131,6 +135,8 @@ pub struct FmuModel {
     /// The last communication step (s), for the vehicles' warning of an axle-box
     /// exchange beyond its stable step.
     last_step: f64,
+    /// Where TrackContact's displacement inputs are measured from (`inputs.datum`).
+    datum: InputDatum,
 }
 
 impl FmuModel {
@@ -225,12 +231,27 @@ impl Model for FmuModel {
                 (Engine::Sim(Box::new(sim)), published)
             }
         };
+        let datum = match &engine {
+            Engine::Sim(sim) if kind == Kind::TrackContact => {
+                let n = sim.wheelsets().len();
+                let statics = (0..n)
+                    .map(|k| match sim.side_frames_of(k) {
+                        Some((z, _)) => z,
+                        None => sim.sample_of(k).map_or([0.0; 2], |s| s.wheel_z),
+                    })
+                    .collect();
+                let relative = values[vr::INPUTS_DATUM as usize] == enums::input_datum::FIRST_STEP;
+                InputDatum::new(relative, statics)
+            }
+            _ => InputDatum::new(false, Vec::new()),
+        };
         Ok(FmuModel {
             kind,
             engine,
             force_limit: force_limit(published.static_load),
             published,
             last_step: 0.0,
+            datum,
         })
     }
 
@@ -259,7 +280,8 @@ impl Model for FmuModel {
                     let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
                     for (k, [zl, zr, vl, vr_]) in frames.take(n).enumerate() {
                         if changed_any(zl, zr) || changed_any(vl, vr_) {
-                            sim.set_side_frames_of(k, [v(zl), v(zr)], [v(vl), v(vr_)])?;
+                            let z = self.datum.apply(k, [v(zl), v(zr)]);
+                            sim.set_side_frames_of(k, z, [v(vl), v(vr_)])?;
                         }
                     }
                     return Ok(());
@@ -268,9 +290,10 @@ impl Model for FmuModel {
                 // the model does not have are kept and unused. A wheel whose height was
                 // not set keeps moving as it was.
                 let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
-                wheel_inputs(sim, 0, lead, values, changed)?;
-                for (k, &refs) in (1..n).zip(&TRAILING_INPUT_VRS) {
-                    wheel_inputs(sim, k, refs, values, changed)?;
+                let refs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
+                for (k, r) in refs.take(n).enumerate() {
+                    let z = self.datum.apply(k, [v(r[0]), v(r[1])]);
+                    wheel_inputs(sim, k, r, z, values, changed)?;
                 }
                 Ok(())
             }
@@ -400,6 +423,7 @@ impl Model for FmuModel {
             Engine::Sim(sim) => {
                 let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
                 sim.advance_to(plan)?;
+                self.datum.fix();
                 if self.kind == Kind::CoupledSystem {
                     sim.check_sample()?;
                 }
@@ -464,18 +488,34 @@ impl Model for FmuModel {
         })
     }
 
+    /// The engine's state, then TrackContact's input datum.
     fn state_vector(&self) -> Result<Vec<f64>, Error> {
-        match &self.engine {
-            Engine::Vehicle(u) => Ok(u.state_vector()),
-            Engine::Sim(sim) => sim.state_vector(),
-        }
+        let mut v = match &self.engine {
+            Engine::Vehicle(u) => u.state_vector(),
+            Engine::Sim(sim) => sim.state_vector()?,
+        };
+        v.extend(self.datum.state());
+        Ok(v)
     }
 
     fn set_state_vector(&mut self, v: &[f64]) -> Result<(), Error> {
+        let n = self.datum.state_len();
+        let Some(split) = v.len().checked_sub(n) else {
+            return Err(crate::error::out_of_range(
+                "state length",
+                v.len() as f64,
+                format!("at least {n} values"),
+            ));
+        };
+        let (engine, datum) = v.split_at(split);
+        let mut restored = self.datum.clone();
+        restored.restore(datum)?;
         match &mut self.engine {
-            Engine::Vehicle(u) => u.set_state_vector(v),
-            Engine::Sim(sim) => sim.set_state_vector(v),
+            Engine::Vehicle(u) => u.set_state_vector(engine)?,
+            Engine::Sim(sim) => sim.set_state_vector(engine)?,
         }
+        self.datum = restored;
+        Ok(())
     }
 
     /// TrackContact (contact interface): the wheel heights' derivatives of order 1 and

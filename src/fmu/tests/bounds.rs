@@ -61,6 +61,35 @@ fn parameter_ranges_follow_from_physics_and_match_the_engine() {
 }
 
 #[test]
+fn the_first_step_s_wheel_heights_are_the_static_state_and_later_ones_move_from_it() {
+    // inputs.datum = first_step (the default): a partner at rest on other heights (2 cm
+    // lower here) starts at rest; a change after the first step moves the wheel.
+    let (mut i, _) = instance(Kind::TrackContact);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    // At standstill the wheel held at its static height stays at the static load.
+    i.set_real(&[vr::SPEED], &[0.0]).unwrap();
+    let mut s = [0.0; 2];
+    i.get_real(&[vr::STATIC_LOAD_LEFT, vr::STATIC_WHEEL_Z_LEFT], &mut s)
+        .unwrap();
+    let [w, z0] = s;
+    let refs = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z];
+    i.set_real(&refs, &[z0 - 0.02, z0 - 0.02]).unwrap();
+    let mut p = [0.0];
+    i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+    assert_eq!(p[0], w);
+    i.do_step(0.0, 1e-4).unwrap();
+    i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+    assert!((p[0] / w - 1.0).abs() < 1e-6, "{} against {w}", p[0]);
+    // 10 um down from there: the contact stiffness, about 1.45e9 N/m, times it.
+    i.set_real(&refs, &[z0 - 0.02 - 1e-5, z0 - 0.02 - 1e-5])
+        .unwrap();
+    i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
+    let k = (p[0] - w) / 1e-5;
+    assert!(k > 1.3e9 && k < 1.6e9, "{k:e}");
+}
+
+#[test]
 fn a_parameter_error_is_reported_once_at_exit_initialization() {
     let (mut i, log) = instance(Kind::TrackContact);
     i.set_real(&[vr::FLAT_LEFT_2_DEPTH], &[1e-3]).unwrap();
@@ -73,6 +102,8 @@ fn a_parameter_error_is_reported_once_at_exit_initialization() {
 #[test]
 fn wheel_inputs_far_into_the_rail_stop_the_run_with_an_error() {
     let (mut i, log) = instance(Kind::TrackContact);
+    // Absolute inputs: the height set before the first step is the wheel's.
+    i.set_integer(&[vr::INPUTS_DATUM], &[2]).unwrap();
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     i.set_real(&[vr::WHEEL_LEFT_Z], &[-0.02]).unwrap();
