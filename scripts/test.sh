@@ -17,9 +17,16 @@ echo "== FMUs: pack fmu/*.fmu and the C header, the library against the glibc 2.
 # against glibc 2.28 (objdump -T checked), which sets up .venv first.
 bash scripts/build_fmus_glibc228.sh fmu
 
-echo "== Python: .venv with fmpy, then the FMU tests"
+echo "== Python: .venv with fmpy, libcosimpy and ecospy, then the FMU tests"
+# ecospy's library needs oneTBB (Debian's libtbb12); CI runs as root with Debian's registries.
+if ! ldconfig -p | grep libtbb.so.12 >/dev/null; then
+    sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq libtbb12
+fi
 python3 python/wheelflat_fmus.py
-.venv/bin/python -m pytest -q tests/test_fmus.py tests/test_study.py
+# test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem
+.venv/bin/python -m pytest -q tests/test_fmus.py tests/test_study.py tests/test_masters.py
 
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
 # bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
