@@ -14,6 +14,7 @@ import json
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -156,8 +157,13 @@ def _run(spec):
     with _lock:
         if key in _cache:
             return _cache[key]
-    p = subprocess.run([sys.executable, os.path.abspath(__file__), key], cwd=ROOT, capture_output=True, text=True,
-                       timeout=300)
+    # ecos unpacks each SSP under $TMPDIR and leaves it there (1.3 MB a run): a private one.
+    tmp = tempfile.mkdtemp(prefix="wheelflat_masters_")
+    try:
+        p = subprocess.run([sys.executable, os.path.abspath(__file__), key], cwd=ROOT, capture_output=True, text=True,
+                           timeout=300, env=dict(os.environ, TMPDIR=tmp))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
     # libcosim logs to stdout, ecos to stderr: both are kept.
     log = p.stdout + p.stderr
     line = next((x for x in p.stdout.splitlines() if x.startswith("RESULT ")), None)
