@@ -20,7 +20,10 @@
 use wheelflat::sim::{
     Scenario, SideFrameSpec, Simulation, TrackWindow, TrailingWheelset, VehicleSpec,
 };
-use wheelflat::vehicle::{HalfCarParams, Quad, RollPlaneParams, SprungBogie, SprungHalfCar};
+use wheelflat::vehicle::{
+    CONTACT_STIFFNESS, ExchangeLimits, HalfCarParams, Quad, RollPlaneParams, SprungBogie,
+    SprungHalfCar,
+};
 
 /// The bodies above the primary suspension.
 #[allow(clippy::large_enum_variant)]
@@ -211,6 +214,23 @@ impl Case {
         Ok((errs, 100.0 * diff / self.load))
     }
 
+    /// The estimated limits ([`wheelflat::vehicle::ExchangeLimits`]) with substeps of at
+    /// most 0.5 ms.
+    fn estimate(&self) -> ExchangeLimits {
+        let sim = Simulation::new(&self.cut).unwrap();
+        let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
+        if self.half_car {
+            let mut b = SprungHalfCar::new(self.h_params, 5e-4).unwrap();
+            b.set_static(boxes).unwrap();
+            b.exchange_limits(boxes, 5e-4, CONTACT_STIFFNESS).unwrap()
+        } else {
+            let mut b = SprungBogie::new(self.p, 5e-4).unwrap();
+            b.set_static(boxes[0]).unwrap();
+            b.exchange_limits(boxes[0], 5e-4, CONTACT_STIFFNESS)
+                .unwrap()
+        }
+    }
+
     /// The largest communication step (s) up to 20 ms below which every step of a
     /// geometric scan (ratio 1.1 from 0.1 ms) keeps the run usable: the history
     /// within 10 % of the static load.
@@ -232,6 +252,27 @@ fn main() {
         .nth(1)
         .map_or(0.6, |a| a.parse().expect("a duration in seconds"));
     let limits = std::env::args().any(|a| a == "--limits");
+    // `--at K1 C1 h`: one case, both vehicles and masters (N/m, N s/m, s).
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--at") {
+        let x: Vec<f64> = args[i + 1..i + 4]
+            .iter()
+            .map(|a| a.parse().unwrap())
+            .collect();
+        for half_car in [false, true] {
+            let case = Case::new(half_car, x[0], x[1], duration);
+            let e = case.estimate();
+            for jacobi in [false, true] {
+                println!(
+                    "half_car {half_car} jacobi {jacobi} h {} ms: {:?} (estimated limit {:.2} ms)",
+                    x[2] * 1e3,
+                    case.run(jacobi, x[2]),
+                    if jacobi { e.jacobi } else { e.sequential } * 1e3
+                );
+            }
+        }
+        return;
+    }
     let d = roll_plane(&Scenario::table_4_4_flat());
     for half_car in [false, true] {
         let name = if half_car {
@@ -241,17 +282,22 @@ fn main() {
         };
         if limits {
             println!("{name}: largest usable communication step (ms), {duration} s");
-            println!("| K_1 (MN/m) | C_1 (kN s/m) | sequential | Jacobi |");
+            println!(
+                "| K_1 (MN/m) | C_1 (kN s/m) | sequential: measured / estimated | Jacobi: measured / estimated |"
+            );
             println!("|---|---|---|---|");
             for k1 in [d.primary_stiffness, 1e8, 7.88e8, 1e10] {
                 for c1 in [0.0, d.primary_damping, 1e6] {
                     let case = Case::new(half_car, k1, c1, duration);
+                    let e = case.estimate();
                     println!(
-                        "| {} | {} | {:.2} | {:.2} |",
+                        "| {} | {} | {:.2} / {:.2} | {:.2} / {:.2} |",
                         k1 / 1e6,
                         c1 / 1e3,
                         case.limit(false) * 1e3,
-                        case.limit(true) * 1e3
+                        e.sequential * 1e3,
+                        case.limit(true) * 1e3,
+                        e.jacobi * 1e3
                     );
                 }
             }
@@ -271,7 +317,7 @@ fn main() {
         println!("|---|---|---|---|");
         for jacobi in [false, true] {
             let master = if jacobi { "Jacobi" } else { "sequential" };
-            for h in [0.5e-3, 1e-3, 2e-3, 3e-3, 4e-3, 6e-3] {
+            for h in [0.1e-3, 0.2e-3, 0.5e-3, 1e-3, 2e-3, 3e-3, 4e-3, 6e-3] {
                 match case.run(jacobi, h) {
                     Err(e) => println!(
                         "| {master} | {:.1} ms | unstable {} | |",

@@ -195,6 +195,28 @@ impl SideFrameInertia {
         }
     }
 
+    /// Advances a side frame at an axle box by one track step `dt` (s) from `(z, v)` (m,
+    /// m/s; the velocity at the half step behind), the axle box at `box_z` (m) moving at
+    /// `box_v` (m/s), under the primary spring `k1` (N/m) and damper `c1` (N s/m), the
+    /// held acceleration from above `free` (m/s^2) and the primary force at the other
+    /// wheelset's box on the same side frame `partner` (N): symplectic Euler with the
+    /// damper implicit in the side frame's velocity, so any damping stays stable.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn advance(
+        &self,
+        (k1, c1, dt): (f64, f64, f64),
+        free: f64,
+        (box_z, box_v): (f64, f64),
+        partner: f64,
+        z: &mut f64,
+        v: &mut f64,
+    ) {
+        let drive = free + self.direct * (k1 * (box_z - *z) + c1 * box_v) + self.cross * partner;
+        *v = (*v + dt * drive) / (1.0 + dt * self.direct * c1);
+        *z += dt * *v;
+    }
+
     /// A side frame of mass `mass` (kg) and pitch inertia `pitch_inertia` (kg m^2) over
     /// two wheelsets `wheelbase` (m) apart, bouncing and pitching (the half-car bogie).
     pub fn pitching(mass: f64, pitch_inertia: f64, wheelbase: f64) -> SideFrameInertia {
@@ -291,6 +313,11 @@ impl PrimaryLink {
         &self.body
     }
 
+    /// The primary stiffness `K_1` (N/m).
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
     /// The side frames' inertia.
     pub fn inertia(&self) -> SideFrameInertia {
         self.inertia
@@ -372,14 +399,16 @@ impl PrimaryLink {
         let f = self.force_now();
         let (zb, vb) = (self.body.wheel_z(), self.body.box_velocity());
         self.body.step(p, f);
-        let dt = self.body.dt;
-        let m = self.inertia;
+        let link = (self.stiffness, self.damping, self.body.dt);
         for i in 0..2 {
-            let drive = self.free[i]
-                + m.direct * (self.stiffness * (zb[i] - self.now_z[i]) + self.damping * vb[i])
-                + m.cross * self.partner[i];
-            self.now_v[i] = (self.now_v[i] + dt * drive) / (1.0 + dt * m.direct * self.damping);
-            self.now_z[i] += dt * self.now_v[i];
+            self.inertia.advance(
+                link,
+                self.free[i],
+                (zb[i], vb[i]),
+                self.partner[i],
+                &mut self.now_z[i],
+                &mut self.now_v[i],
+            );
         }
         self.last = f;
         self.force_sum[0] += f[0];
@@ -394,11 +423,11 @@ impl PrimaryLink {
     }
 
     /// Values of [`PrimaryLink::state_vector`].
-    const STATE_LEN: usize = 24;
+    const STATE_LEN: usize = 22;
 
     /// The wheelset's state (5), then the side frames at the input (z, v), the steps
     /// and force sums since the last input, the side frames now (z, v), the load from
-    /// above, the partner's and the last primary forces: 24 values.
+    /// above, the partner's and the last primary forces: 22 values.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = self.body.state_vector();
         v.extend(self.frame_z);
@@ -481,6 +510,11 @@ impl SprungBogie {
     /// Step (s).
     pub fn dt(&self) -> f64 {
         self.cd.dt()
+    }
+
+    /// Parameters.
+    pub fn params(&self) -> &RollPlaneParams {
+        &self.params
     }
 
     /// Changes the step to `dt` (s), keeping the displacements and the

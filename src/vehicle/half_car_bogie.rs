@@ -262,6 +262,11 @@ impl SprungHalfCar {
         })
     }
 
+    /// Parameters.
+    pub fn params(&self) -> &HalfCarParams {
+        &self.params
+    }
+
     /// Step (s).
     pub fn dt(&self) -> f64 {
         self.cd.dt()

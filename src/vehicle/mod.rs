@@ -17,6 +17,7 @@
 //! Roll angles are positive when they raise the right side (docs/MODEL.md).
 
 mod axle_box;
+mod exchange;
 mod half_car;
 mod half_car_bogie;
 mod lumped;
@@ -25,6 +26,7 @@ mod roll_plane;
 mod tests;
 
 pub use axle_box::{PrimaryLink, SideFrameInertia, SprungBogie, WheelsetBody};
+pub use exchange::{CONTACT_STIFFNESS, ExchangeLimits};
 pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
 };

@@ -451,19 +451,33 @@ impl Model for FmuModel {
     /// communication step above [`VehicleUnit::axle_box_step_limit`].
     fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
         if let Engine::Vehicle(u) = &self.engine {
-            let limit = u.axle_box_step_limit()?;
-            return (self.last_step > limit).then(|| {
+            let e = u.exchange_limits()?;
+            let h = self.last_step;
+            return (h > e.jacobi).then(|| {
+                let which = if h > e.sequential {
+                    "under any master"
+                } else {
+                    "under a Jacobi master (OSP libcosim, ecos: every unit from the same \
+                     communication point); a sequential one that steps TrackContact first and \
+                     hands this unit its primary.*.mean_force stays stable to that step"
+                };
                 (
                     "axle-box step",
                     format!(
-                        "at t = {time} s the communication step {} s is above about {} s, the \
-                     largest at which the axle-box interface's exchange of the primary forces \
-                     stays stable (the primary dampers against the side frames: 2 m / C_1, \
-                     for the half-car bogie 2 J / (2 C_1 (wheelbase/2)^2) with J = \
-                     vehicle.sideframe.pitch_inertia): expect it to diverge; use shorter \
-                     steps",
-                        num(self.last_step),
-                        num(limit)
+                        "at t = {time} s the communication step {} s is above {} s, the largest \
+                     at which the axle-box exchange stays stable {which} (estimated from the \
+                     exchange's amplification matrix: the primary springs and dampers \
+                     vehicle.primary.* exchanged explicitly against the side frames' inertia; \
+                     {} s under a sequential master): expect it to diverge; use steps of at \
+                     most {} s",
+                        num(h),
+                        num(if h > e.sequential {
+                            e.sequential
+                        } else {
+                            e.jacobi
+                        }),
+                        num(e.sequential),
+                        num(e.jacobi)
                     ),
                 )
             });

@@ -1,0 +1,360 @@
+//! The stability of the axle-box exchange: the bodies above the primary suspension
+//! ([`SprungBogie`], [`SprungHalfCar`]) exchange with a track that carries the wheelsets
+//! and moves the side frames on under their own inertia over each step
+//! ([`super::PrimaryLink`]), every communication step `h`. The exchange is explicit: the
+//! bogie holds the primary forces the track computed over the step (the mean of the step
+//! under a sequential master, the force at the communication point under a Jacobi
+//! master, which hands it on one step later). Springs and dampers both enter it.
+//!
+//! [`exchange_limits`] estimates the largest stable `h` of each master kind from the
+//! spectral radius of the exchange's amplification matrix: the linear map of one
+//! communication step, perturbations about the static state, of the bogie's state
+//! (with its own substeps), the side frames the track carries, and the forces the
+//! partners hold, with the axle boxes held still (the stiff contact keeps the
+//! wheelset nearly still at the side frame's frequencies). The estimate covers every
+//! term that crosses the cut: the primary springs (`K_1`, any value, also with `C_1 = 0`)
+//! and dampers. Measured against the whole model on the track
+//! (`examples/axle_box_masters.rs --limits`) it is in docs/VALIDATION.md.
+
+use super::{PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie, SprungHalfCar};
+use crate::error::Result;
+use nalgebra::DMatrix;
+
+/// The track's step the estimate uses (s): the default converged grid's, about 14.4 us.
+const TRACK_STEP: f64 = 14.4e-6;
+
+/// The bodies above the primary suspension, as the exchange sees them: forces in and
+/// side-frame motion out at each axle box.
+trait SprungBody: Clone {
+    /// Axle boxes: 2 (roll-plane vehicle) or 4 (half-car bogie, wheelset by wheelset,
+    /// left then right).
+    fn boxes(&self) -> usize;
+    /// The side frames' displacements and velocities at the axle boxes (m, m/s).
+    fn frames(&self) -> (Vec<f64>, Vec<f64>);
+    /// One substep under the primary forces `f` at the axle boxes (N, pushing the side
+    /// frames up).
+    fn step_boxes(&mut self, f: &[f64]);
+    /// The integrator's state `[dt, d, d_prev]`.
+    fn state(&self) -> Vec<f64>;
+    /// Sets the displacements of [`SprungBody::state`] (the step unchanged).
+    fn set_state(&mut self, v: &[f64]);
+    /// Changes the substep to `dt` (s), below the bogie's critical step.
+    fn set_step(&mut self, dt: f64);
+}
+
+impl SprungBody for SprungBogie {
+    fn boxes(&self) -> usize {
+        2
+    }
+    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
+        let (z, v) = self.side_frames();
+        (z.to_vec(), v.to_vec())
+    }
+    fn step_boxes(&mut self, f: &[f64]) {
+        self.step([f[0], f[1]]);
+    }
+    fn state(&self) -> Vec<f64> {
+        self.state_vector()
+    }
+    fn set_state(&mut self, v: &[f64]) {
+        // The same step and displacements of the same length: always accepted.
+        let _ = self.set_state_vector(v);
+    }
+    fn set_step(&mut self, dt: f64) {
+        // At most the base step, which the bogie accepted.
+        let _ = self.change_dt(dt);
+    }
+}
+
+impl SprungBody for SprungHalfCar {
+    fn boxes(&self) -> usize {
+        4
+    }
+    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
+        let (z, v) = self.side_frames();
+        (z.concat(), v.concat())
+    }
+    fn step_boxes(&mut self, f: &[f64]) {
+        let q: Quad = [[f[0], f[1]], [f[2], f[3]]];
+        self.step(q);
+    }
+    fn state(&self) -> Vec<f64> {
+        self.state_vector()
+    }
+    fn set_state(&mut self, v: &[f64]) {
+        let _ = self.set_state_vector(v);
+    }
+    fn set_step(&mut self, dt: f64) {
+        let _ = self.change_dt(dt);
+    }
+}
+
+/// The largest stable communication steps (s) of the axle-box exchange, estimated as
+/// the module says.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExchangeLimits {
+    /// Under a sequential master (track first, the bogie with the mean force of the
+    /// step just taken).
+    pub sequential: f64,
+    /// Under a Jacobi master (every unit from the same communication point, the bogie
+    /// with the force at that point): OSP libcosim's and ecos' fixed-step algorithms.
+    pub jacobi: f64,
+}
+
+/// The track side of the cut: the wheelsets under the bogie, each on a contact spring
+/// to a still rail, with their primary suspensions and the side frames the track moves
+/// on ([`PrimaryLink`]).
+#[derive(Debug, Clone)]
+struct TrackSide {
+    links: Vec<PrimaryLink>,
+    /// Contact stiffness per wheel (N/m) and the static contact forces and wheel heights.
+    support: f64,
+    p0: Vec<[f64; 2]>,
+    z0: Vec<[f64; 2]>,
+}
+
+/// Values of a link's state that move: the wheelset `[d, d_prev]` (4), the side frames
+/// now `z`, `v` (4), the partner's and the last primary forces (4); indices into
+/// [`PrimaryLink::state_vector`]. A wheelset alone under its side frames has no partner:
+/// its first 8 only (the others would stay as they are, eigenvalues 1 of nothing).
+const LINK_MOVING: [usize; 12] = [1, 2, 3, 4, 12, 13, 14, 15, 18, 19, 20, 21];
+
+impl TrackSide {
+    /// One track step of every link: the contact forces of the springs, then the
+    /// partners' forces handed across a shared side frame.
+    fn step(&mut self) {
+        for (k, link) in self.links.iter_mut().enumerate() {
+            let (z, v) = (link.body().wheel_z(), link.body().box_velocity());
+            let p = [0, 1].map(|s| {
+                self.p0[k][s] - self.support * (z[s] - self.z0[k][s]) - SUPPORT_DAMPING * v[s]
+            });
+            link.step(p);
+        }
+        if self.links.len() == 2 {
+            let (a, b) = (self.links[0].last_force(), self.links[1].last_force());
+            self.links[0].set_partner_force(b);
+            self.links[1].set_partner_force(a);
+        }
+    }
+}
+
+/// The amplification matrix of one communication step `h` (s) of the exchange about the
+/// state of `body` and `track`, bogie substeps of at most `base` (s); `jacobi`: the bogie
+/// holds the force at the communication point, else the mean of the step.
+fn amplification<B: SprungBody>(
+    body: &B,
+    track: &TrackSide,
+    h: f64,
+    base: f64,
+    jacobi: bool,
+) -> DMatrix<f64> {
+    let sub = (h / base).ceil().max(1.0);
+    let mut body = body.clone();
+    body.set_step(h / sub);
+    let body = &body;
+    let steps = (h / TRACK_STEP).ceil().max(1.0);
+    let mut track = track.clone();
+    for l in &mut track.links {
+        // A step no longer than the contact's and the bogie's, as the track's.
+        let _ = l.change_dt(h / steps);
+    }
+    let track = &track;
+    let s0 = body.state();
+    let nv = s0.len() - 1;
+    let moving = if track.links.len() == 2 {
+        &LINK_MOVING[..]
+    } else {
+        &LINK_MOVING[..8]
+    };
+    let states: Vec<Vec<f64>> = track.links.iter().map(|l| l.state_vector()).collect();
+    let mut reference = s0[1..].to_vec();
+    for st in &states {
+        reference.extend(moving.iter().map(|&i| st[i]));
+    }
+    let n = reference.len();
+    let map = |x: &[f64]| -> Vec<f64> {
+        let mut b = body.clone();
+        let mut st = vec![s0[0]];
+        st.extend(&x[..nv]);
+        b.set_state(&st);
+        let mut t = track.clone();
+        for (k, l) in t.links.iter_mut().enumerate() {
+            let mut v = states[k].clone();
+            for (j, &i) in moving.iter().enumerate() {
+                v[i] = x[nv + moving.len() * k + j];
+            }
+            // The same lengths and step: always accepted.
+            let _ = l.set_state_vector(&v);
+        }
+        // The force at the communication point, then the track takes the bogie's side
+        // frames and steps.
+        let at_point: Vec<f64> = t.links.iter().flat_map(|l| l.force_now()).collect();
+        let (fz, fv) = b.frames();
+        for (k, l) in t.links.iter_mut().enumerate() {
+            l.set_side_frames([fz[2 * k], fz[2 * k + 1]], [fv[2 * k], fv[2 * k + 1]]);
+        }
+        for _ in 0..steps as usize {
+            t.step();
+        }
+        let held: Vec<f64> = if jacobi {
+            at_point
+        } else {
+            t.links.iter().flat_map(|l| l.mean_force()).collect()
+        };
+        for _ in 0..sub as usize {
+            b.step_boxes(&held);
+        }
+        let mut out = b.state()[1..].to_vec();
+        for l in &t.links {
+            let v = l.state_vector();
+            out.extend(moving.iter().map(|&i| v[i]));
+        }
+        out
+    };
+    // Each value in units of a displacement (m): velocities times the step, forces
+    // over the primary stiffness, so that the matrix is balanced (its eigenvalues are
+    // those of the map in any units).
+    let k1 = track.links[0].stiffness();
+    let unit: Vec<f64> = (0..n)
+        .map(|j| match j.checked_sub(nv).map(|r| r % moving.len()) {
+            None | Some(0..=5) => 1.0,
+            Some(6 | 7) => 1.0 / h,
+            Some(_) => k1,
+        })
+        .collect();
+    let base_out = map(&reference);
+    let mut a = DMatrix::zeros(n, n);
+    for j in 0..n {
+        let delta = 1e-6 * unit[j];
+        let mut x = reference.clone();
+        x[j] += delta;
+        let y = map(&x);
+        for i in 0..n {
+            a[(i, j)] = (y[i] - base_out[i]) / delta * unit[j] / unit[i];
+        }
+    }
+    a
+}
+
+/// Spectral radius of `a`.
+fn spectral_radius(a: &DMatrix<f64>) -> f64 {
+    a.complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max)
+}
+
+/// The largest `h` of a geometric scan from 0.05 ms (ratio 1.1, up to 20 ms) below
+/// which every step keeps the spectral radius at most 1 (to 1e-9).
+fn largest_stable<B: SprungBody>(body: &B, track: &TrackSide, base: f64, jacobi: bool) -> f64 {
+    let mut h = 5e-5;
+    while h < 20e-3 {
+        let next = h * 1.1;
+        if spectral_radius(&amplification(body, track, next, base, jacobi)) > 1.0 + 1e-9 {
+            return h;
+        }
+        h = next;
+    }
+    h
+}
+
+/// The track side under `body` at rest with its axle boxes at `z_box` (m), one link per
+/// wheelset of `wheelset` (its mass, inertia, primary suspension, gravity) with side
+/// frames of `inertia`, on contact springs of `support` (N/m per wheel).
+fn track_side<B: SprungBody>(
+    body: &B,
+    wheelset: &RollPlaneParams,
+    inertia: SideFrameInertia,
+    z_box: &[f64],
+    support: f64,
+) -> Result<TrackSide> {
+    let (zf, _) = body.frames();
+    let k1 = wheelset.primary_stiffness;
+    let w = 0.5 * wheelset.wheelset_mass * wheelset.gravity;
+    let mut links = Vec::new();
+    let (mut p0, mut z0) = (Vec::new(), Vec::new());
+    for k in 0..body.boxes() / 2 {
+        let zb = [z_box[2 * k], z_box[2 * k + 1]];
+        // The contact forces that carry the bogie's static primary forces and the
+        // wheelset's weight.
+        let p = [0, 1].map(|s| k1 * (zb[s] - zf[2 * k + s]) + w);
+        let mut link = PrimaryLink::new(wheelset, TRACK_STEP, inertia)?;
+        link.set_static(zb, p);
+        links.push(link);
+        p0.push(p);
+        z0.push(zb);
+    }
+    Ok(TrackSide {
+        links,
+        support,
+        p0,
+        z0,
+    })
+}
+
+fn limits_of<B: SprungBody>(body: &B, track: &TrackSide, base: f64) -> ExchangeLimits {
+    ExchangeLimits {
+        sequential: largest_stable(body, track, base, false),
+        jacobi: largest_stable(body, track, base, true),
+    }
+}
+
+/// Damping of the support under each wheel (N s/m): the rail pads' and ballast's that the
+/// wheel feels through the rail, of the order of table 4.4's pad damping; without it the
+/// wheelset on its contact spring is an undamped oscillator, which any explicit
+/// exchange nudges past a spectral radius of 1.
+const SUPPORT_DAMPING: f64 = 1e5;
+
+/// Contact stiffness per wheel (N/m) the estimates take by default: the adaptive
+/// contact's at the static load of table 4.4, about 1.45e9 N/m.
+pub const CONTACT_STIFFNESS: f64 = 1.45e9;
+
+impl SprungBogie {
+    /// [`ExchangeLimits`] of this bogie at rest with its axle boxes at `z_box` (m), its
+    /// substeps at most `base` (s), its wheelset on contact springs of `support` (N/m
+    /// per wheel, [`CONTACT_STIFFNESS`]), side frames of its own mass.
+    ///
+    /// Errors: a parameter [`PrimaryLink::new`] refuses.
+    pub fn exchange_limits(
+        &self,
+        z_box: [f64; 2],
+        base: f64,
+        support: f64,
+    ) -> Result<ExchangeLimits> {
+        let p = *self.params();
+        let inertia = SideFrameInertia::single(p.sideframe_mass);
+        let track = track_side(self, &p, inertia, &z_box, support)?;
+        Ok(limits_of(self, &track, base))
+    }
+}
+
+impl SprungHalfCar {
+    /// [`ExchangeLimits`] of this bogie at rest with its axle boxes at `z_box` (m), as
+    /// [`SprungBogie::exchange_limits`], its pitching side frames shared by the two
+    /// wheelsets.
+    ///
+    /// Errors: a parameter [`PrimaryLink::new`] refuses.
+    pub fn exchange_limits(&self, z_box: Quad, base: f64, support: f64) -> Result<ExchangeLimits> {
+        let h = *self.params();
+        let inertia =
+            SideFrameInertia::pitching(h.sideframe_mass, h.sideframe_pitch_inertia, h.wheelbase);
+        // The wheelset and primary suspension only ([`PrimaryLink`] uses no more).
+        let wheelset = RollPlaneParams {
+            carbody_mass: 0.0,
+            bolster_mass: 0.0,
+            bolster_inertia: 0.0,
+            sideframe_mass: 0.0,
+            wheelset_mass: h.wheelset_mass,
+            wheelset_inertia: h.wheelset_inertia,
+            primary_stiffness: h.primary_stiffness,
+            primary_damping: h.primary_damping,
+            primary_spacing: h.primary_spacing,
+            secondary_stiffness: 0.0,
+            secondary_damping: 0.0,
+            secondary_spacing: 0.0,
+            gravity: h.gravity,
+        };
+        let track = track_side(self, &wheelset, inertia, &z_box.concat(), support)?;
+        Ok(limits_of(self, &track, base))
+    }
+}
