@@ -107,7 +107,8 @@ fn variables(table: &Table, fmu: &Fmu) -> String {
                 if !used_enums.contains(&t) {
                     used_enums.push(t);
                 }
-                format!("{} {}", v.ty(), xml_escape(t))
+                // Written as an Integer (model_description.rs says why).
+                format!("Integer ({})", xml_escape(t))
             }
             None => v.ty().to_string(),
         };
@@ -128,7 +129,7 @@ fn variables(table: &Table, fmu: &Fmu) -> String {
             unit(v),
             xml_escape(v.get("start").unwrap_or("")),
             xml_escape(&limits),
-            xml_escape(v.get("description").unwrap_or(""))
+            xml_escape(&crate::model_description::description(table, v))
         )
         .unwrap();
     }

@@ -149,10 +149,11 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
 }
 
 /// One `<ScalarVariable>`, numbered `k` in a comment.
-fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
-    let enumeration = v.ty() == "Enumeration";
-    let description = match (enumeration, v.get("declaredType")) {
-        (true, Some(ty)) => format!(
+/// The description of `v` as the model description gives it: an enumeration's with its
+/// items' codes and names appended, `(1 = adaptive, 2 = hertz)`.
+pub fn description(table: &Table, v: &FmuVar) -> String {
+    match (v.ty(), v.get("declaredType")) {
+        ("Enumeration", Some(ty)) => format!(
             "{} ({})",
             v.get("description").unwrap_or(""),
             table.enums[ty]
@@ -162,7 +163,12 @@ fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
                 .join(", ")
         ),
         _ => v.get("description").unwrap_or("").to_string(),
-    };
+    }
+}
+
+fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
+    let enumeration = v.ty() == "Enumeration";
+    let description = description(table, v);
     let mut line = format!(
         "    <!-- {k} -->\n    <ScalarVariable name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\"",
         xml_escape(v.name()),

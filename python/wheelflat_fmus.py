@@ -257,7 +257,10 @@ def run_bogie(paths, stop_time, wheelsets=2, track_params=None, vehicle_params=N
 
 
 FRAMES = ("sideframe.left.z", "sideframe.right.z", "sideframe.left.v", "sideframe.right.v")
-PRIMARY = ("primary.left.force", "primary.right.force")
+# The mean primary forces over the track's step just taken: what a sequential master
+# (track first) hands the vehicle. A Jacobi master (libcosim, ecos) hands it
+# primary.*.force, the force at the communication point.
+PRIMARY = ("primary.left.mean_force", "primary.right.mean_force")
 AXLE_BOX = ("axle_box.left.force", "axle_box.right.force")
 
 
@@ -266,7 +269,7 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
     axle_box): TrackContact carries the wheelset and its primary suspension,
     RollPlaneVehicle the bodies above. Per communication step: the side frames' motion
     (``sideframe.*.z``, ``.v``) to the track, the track steps, its mean primary forces
-    over that step (``primary.*.force``) to the vehicle (``axle_box.*.force``), the
+    over that step (``primary.*.mean_force``) to the vehicle (``axle_box.*.force``), the
     vehicle steps (track first: a Gauss-Seidel exchange). Returns the track's largest
     contact forces ``[left, right]`` (N) over the run; ``record``, a list, receives
     ``[time, contact forces, mean primary forces]`` at every communication point."""

@@ -94,7 +94,7 @@ impl InputRates {
 
     /// Whether the wheel heights move between inputs.
     #[inline(always)]
-    pub(super) fn moves(&self) -> bool {
+    pub fn moves(&self) -> bool {
         self.z_given[0] || self.z_given[1]
     }
 

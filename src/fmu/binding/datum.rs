@@ -55,6 +55,12 @@ impl InputDatum {
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
     }
 
+    /// Whether the inputs stand for the static state whatever they are (before the first
+    /// step, with `first_step`).
+    pub(super) fn follows(&self) -> bool {
+        self.relative && !self.fixed
+    }
+
     /// The first step is taken: the offsets stay as they are.
     pub(super) fn fix(&mut self) {
         self.fixed = true;

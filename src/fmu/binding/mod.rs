@@ -6,6 +6,7 @@ mod datum;
 mod outputs;
 mod parameters;
 mod unit;
+mod watch;
 
 pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};
 pub use unit::{END_ZONE_SPANS, FmuModel};

@@ -103,8 +103,9 @@ pub trait Model: Clone + Sized {
 
     /// A warning about the state after a successful step at the communication time
     /// `time` (s): its kind (a short fixed name) and the message. `fmi2DoStep` returns
-    /// `fmi2Warning` after every step the condition holds and logs the message the
-    /// first time of each kind in a run (until `fmi2Reset`).
+    /// `fmi2Warning` after every step the condition holds, with the message the first
+    /// time of each kind in a run (until `fmi2Reset`) and a line that it still holds
+    /// after.
     fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)>;
 
     /// Everything that determines the continuation, for serialized FMU states.

@@ -107,12 +107,16 @@ impl<M: Model> Instance<M> {
         self.time = end;
         let warning = self.model.as_mut().and_then(|m| m.step_warning(end));
         if let Some((kind, w)) = warning {
-            // The step was taken: the warning is the status, logged once per kind.
-            let message = format!("fmi2DoStep: {w}");
-            if !self.step_warned.contains(&kind) {
+            // The step was taken: the warning is the status. FMI 2.0 expects the logger
+            // called with every fmi2Warning: the whole message the first time of each
+            // kind in a run, a line that it still holds after.
+            let message = if self.step_warned.contains(&kind) {
+                format!("fmi2DoStep: at t = {end} s still: {kind} (as warned before)")
+            } else {
                 self.step_warned.push(kind);
-                self.warn(&message);
-            }
+                format!("fmi2DoStep: {w}")
+            };
+            self.warn(&message);
             return Err(super::status::Refusal {
                 status: Status::Warning,
                 message,

@@ -78,7 +78,8 @@ fn the_first_step_s_wheel_heights_are_the_static_state_and_later_ones_move_from_
     let mut p = [0.0];
     i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
     assert_eq!(p[0], w);
-    i.do_step(0.0, 1e-4).unwrap();
+    // Seven track steps with the heights held: taken, and warned of.
+    stepped(i.do_step(0.0, 1e-4), true);
     i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap();
     assert!((p[0] / w - 1.0).abs() < 1e-6, "{} against {w}", p[0]);
     // 10 um down from there: the contact stiffness, about 1.45e9 N/m, times it.
@@ -372,7 +373,7 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
         log.lock()
             .unwrap()
             .iter()
-            .filter(|m| m.contains("fixed rail end"))
+            .filter(|m| m.contains("fixed rail end") && !m.contains("still"))
             .count()
     };
     // Default track: 30 spans of 0.685 m, 20.55 m; the zone starts two spans before
@@ -386,7 +387,7 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
     assert_eq!(warnings(&log), 0, "not yet in the zone at {t} s");
     let before = i.get_state().unwrap();
     // Every step in the zone returns fmi2Warning (the step is taken); the message is
-    // logged once.
+    // logged once, a line that it still holds after.
     let mut statuses = Vec::new();
     while t < 0.93 - 1e-9 {
         statuses.push(i.do_step(t, h).map_err(|r| r.status));

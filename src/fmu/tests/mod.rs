@@ -53,3 +53,13 @@ pub(super) const FORCES: [u32; 4] = [
     vr::WHEEL_LEFT_Z,
     vr::POSITION,
 ];
+
+/// A step that went through: `fmi2OK`, or `fmi2Warning` when `warned` (a communication
+/// step beyond what the contact exchange tolerates, say, taken and warned of).
+pub(super) fn stepped(r: crate::fmu::fmi2::FmiResult, warned: bool) {
+    match r {
+        Ok(()) => assert!(!warned, "a warning was expected"),
+        Err(e) if warned && e.status == Status::Warning => {}
+        Err(e) => panic!("{e:?}"),
+    }
+}

@@ -1,0 +1,228 @@
+//! What TrackContact sees of its exchange with the vehicle at the contact interface,
+//! for the warnings of `fmi2DoStep` ([`crate::fmu::fmi2::Model::step_warning`]):
+//!
+//! * the communication step against the track's own: the wheel heights are held over a
+//!   step (or extrapolated with the derivatives of `fmi2SetRealInputDerivatives`), so
+//!   the exchange's error grows with the step (measured on the reference flat, peak of
+//!   the leading wheel: held heights under a sequential master +1.3 % at 2 track steps,
+//!   +5.5 % at 5, +12 % at 10; under a Jacobi master, OSP libcosim and ecos, +2.4 %,
+//!   +8.6 % and +20 %; with the wheel velocities +0.7 % at 5 and +2.9 % at 10);
+//! * chatter: a contact force that jumps up and down at every communication point, the
+//!   mark of an explicit exchange beyond its stability (10 track steps, Jacobi: peaks
+//!   of 615 kN and contact lost 31 % of the time, every force under the health bound);
+//! * the axle's rotation against the track's motion: the flats meet the rail where
+//!   `wheel.rotation` puts them, so an axle that turns at another rate than the track's
+//!   `speed / wheel.radius` (a vehicle at its own speed while the track brakes) hits
+//!   the rail at the wrong places.
+//!
+//! The watch is no part of FMU states: a restored state starts it afresh.
+
+use crate::error::num;
+
+/// Communication steps, in track steps, beyond which the contact exchange's error
+/// passes about 1 % on the peak: with held wheel heights, and with their derivatives.
+pub(super) const HELD_STEPS: f64 = 1.5;
+pub(super) const INTERPOLATED_STEPS: f64 = 5.5;
+
+/// Consecutive communication steps at which a contact force reverses its change by more
+/// than [`CHATTER_JUMP`] of the static load: chatter.
+const CHATTER_RUN: u32 = 6;
+const CHATTER_JUMP: f64 = 0.1;
+
+/// The axle's rate may differ from the track's `V / R_w` by this fraction (or by
+/// [`RATE_FLOOR`]) before the watch warns.
+const RATE_TOLERANCE: f64 = 0.01;
+const RATE_FLOOR: f64 = 0.05;
+
+/// One wheel's contact forces at the communication points.
+#[derive(Debug, Clone, Copy, Default)]
+struct Wheel {
+    force: Option<f64>,
+    change: f64,
+    run: u32,
+}
+
+/// The rotation input of a wheelset when it was last given: time (s), angle (rad),
+/// the track's position then (m).
+#[derive(Debug, Clone, Copy)]
+struct Rotation {
+    time: f64,
+    angle: f64,
+    position: f64,
+}
+
+/// The watch of TrackContact's contact exchange.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ContactWatch {
+    wheels: Vec<[Wheel; 2]>,
+    rotations: Vec<Option<Rotation>>,
+    /// The axle rate that disagrees with the track's motion, in words.
+    rate: Option<String>,
+    /// The master has set wheel heights: there is an exchange to watch.
+    coupled: bool,
+}
+
+impl ContactWatch {
+    /// A watch of `wheelsets` wheelsets.
+    pub(super) fn new(wheelsets: usize) -> ContactWatch {
+        ContactWatch {
+            wheels: vec![[Wheel::default(); 2]; wheelsets],
+            rotations: vec![None; wheelsets],
+            rate: None,
+            coupled: false,
+        }
+    }
+
+    /// The master set wheel heights.
+    pub(super) fn coupled(&mut self) {
+        self.coupled = true;
+    }
+
+    /// Whether the master has set wheel heights since the start.
+    pub(super) fn is_coupled(&self) -> bool {
+        self.coupled
+    }
+
+    /// Wheelset `k`'s axle angle `angle` (rad) given at `time` (s), the track at
+    /// `position` (m) then, of wheel radius `radius` (m): its rate since the last one
+    /// against the track's mean `V / R_w` over the same time.
+    pub(super) fn rotation_given(
+        &mut self,
+        k: usize,
+        time: f64,
+        angle: f64,
+        position: f64,
+        radius: f64,
+    ) {
+        let Some(slot) = self.rotations.get_mut(k) else {
+            return;
+        };
+        let now = Rotation {
+            time,
+            angle,
+            position,
+        };
+        if let Some(last) = *slot {
+            let dt = time - last.time;
+            if dt > 0.0 {
+                let rate = (angle - last.angle) / dt;
+                let expected = (position - last.position) / (radius * dt);
+                if (rate - expected).abs() > (RATE_TOLERANCE * expected.abs()).max(RATE_FLOOR) {
+                    let name = if k == 0 {
+                        "wheel.rotation".to_string()
+                    } else {
+                        format!("wheelset[{}].wheel.rotation", k + 1)
+                    };
+                    self.rate = Some(format!(
+                        "{name} turned at {} rad/s from t = {} s to {} s, but the track moved \
+                         at {} m/s there, which rolls the axle at {} rad/s (speed / \
+                         wheel.radius): the flats meet the rail where {name} puts them, so \
+                         they hit it at the wrong places; give the vehicle the speed the track \
+                         has (RollPlaneVehicle's and HalfCarBogie's speed is an input)",
+                        num(rate),
+                        num(last.time),
+                        num(time),
+                        num(expected * radius),
+                        num(expected)
+                    ));
+                } else {
+                    self.rate = None;
+                }
+            }
+        }
+        *slot = Some(now);
+    }
+
+    /// The rotation rate's disagreement with the track's motion, if the last one showed
+    /// it.
+    pub(super) fn rate_warning(&self) -> Option<String> {
+        self.rate.clone()
+    }
+
+    /// The contact forces `forces` (N, per wheelset `[left, right]`) at a communication
+    /// point, with the static load `load` (N): a wheel whose force has reversed its
+    /// change by more than a tenth of the static load at each of the last
+    /// [`CHATTER_RUN`] points chatters; its name, if any.
+    pub(super) fn forces_at_point(&mut self, forces: &[[f64; 2]], load: f64) -> Option<String> {
+        let mut chatter = None;
+        for (k, (w, f)) in self.wheels.iter_mut().zip(forces).enumerate() {
+            for s in 0..2 {
+                let wheel = &mut w[s];
+                if let Some(before) = wheel.force {
+                    let change = f[s] - before;
+                    let big = change.abs() > CHATTER_JUMP * load;
+                    wheel.run = if big && change * wheel.change < 0.0 {
+                        wheel.run + 1
+                    } else {
+                        0
+                    };
+                    wheel.change = change;
+                }
+                wheel.force = Some(f[s]);
+                if wheel.run >= CHATTER_RUN && chatter.is_none() {
+                    let side = if s == 0 { "left" } else { "right" };
+                    chatter = Some(if k == 0 {
+                        format!("contact.{side}.force")
+                    } else {
+                        format!("wheelset[{}].contact.{side}.force", k + 1)
+                    });
+                }
+            }
+        }
+        chatter
+    }
+
+    /// Forgets what was seen (a restored FMU state).
+    pub(super) fn restart(&mut self) {
+        let coupled = self.coupled;
+        *self = ContactWatch::new(self.wheels.len());
+        self.coupled = coupled;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_force_that_reverses_at_every_point_chatters_and_a_ringing_one_does_not() {
+        let load = 1e5;
+        let mut w = ContactWatch::new(1);
+        // Up and down by 30 kN at every point: chatter from the sixth reversal on.
+        let mut seen = Vec::new();
+        for n in 0..10 {
+            let f = if n % 2 == 0 { 1.2e5 } else { 0.9e5 };
+            seen.push(w.forces_at_point(&[[f, load]], load).is_some());
+        }
+        assert_eq!(
+            seen,
+            [
+                false, false, false, false, false, false, false, true, true, true
+            ]
+        );
+        // An impact that rings at 7 points per period (1 kHz at 10 track steps): none.
+        let mut w = ContactWatch::new(1);
+        for n in 0..200 {
+            let f = load + 2e5 * (std::f64::consts::TAU * n as f64 / 7.0).sin();
+            assert!(w.forces_at_point(&[[f, load]], load).is_none(), "{n}");
+        }
+    }
+
+    #[test]
+    fn an_axle_that_turns_at_another_rate_than_the_track_rolls_is_named() {
+        let mut w = ContactWatch::new(1);
+        let r = 0.42;
+        // The track brakes from 19.44 m/s to 10 m/s, the axle keeps turning at 19.44 / r.
+        w.rotation_given(0, 0.0, 0.0, 0.0, r);
+        w.rotation_given(0, 0.1, 0.1 * 19.44 / r, 1.0, r);
+        let m = w.rate_warning().unwrap();
+        assert!(m.starts_with("wheel.rotation turned at 46.28"), "{m}");
+        assert!(
+            m.contains("moved at 9.99") && m.contains("axle at 23.80"),
+            "{m}"
+        );
+        // Rolling as the track moves: no warning.
+        w.rotation_given(0, 0.2, 0.1 * 19.44 / r + 1.0 / r, 2.0, r);
+        assert!(w.rate_warning().is_none());
+    }
+}
