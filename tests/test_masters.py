@@ -294,14 +294,27 @@ def test_contact_at_track_step(vehicle):
 
 
 def test_contact_chatter_is_flagged():
-    """(d) The contact coupling at 10 times the track's step in libcosim: TrackContact
-    warns through the master's log that the contact chatters."""
+    """(d) The contact coupling at 10 times the track's step in libcosim. The half-car's
+    four wheels chatter (their forces jump up and down at every communication point,
+    peaks of hundreds of percent): TrackContact says so through the master's log at
+    fmi2Warning. The roll-plane pair does not chatter there but is 20 % off: the step
+    beyond what the exchange tolerates is named, with the step to use."""
+    h = shipped_step("HalfCarBogie", "contact")
+    r = _run(spec("libcosim", "ssp", "HalfCarBogie", "contact", step=10 * h))
+    warnings = [x for x in r["log"].splitlines() if "[warning]" in x]
+    reference = monolithic("HalfCarBogie")["peaks"]
+    assert max(p / q for p, q in zip(r["peaks"], reference)) > 1.5, (r["peaks"], reference)
+    assert any("the contact exchange chatters" in x for x in warnings), \
+        f"no chatter warning in libcosim's log (peaks {[round(x) for x in r['peaks']]} N against " \
+        f"{[round(x) for x in reference]} N); warnings: {warnings[:5]}"
     h = shipped_step("RollPlaneVehicle", "contact")
     r = _run(spec("libcosim", "ssp", "RollPlaneVehicle", "contact", step=10 * h))
     warnings = [x for x in r["log"].splitlines() if "[warning]" in x]
-    assert any("chatter" in x.lower() for x in warnings), \
-        f"no chatter warning in libcosim's log (peaks {[round(x) for x in r['peaks']]} N against " \
-        f"{[round(x) for x in monolithic('RollPlaneVehicle')['peaks']]} N); warnings: {warnings[:5]}"
+    assert any("is 10.0 track steps" in x and "with the wheel heights held" in x for x in warnings), warnings[:5]
+    # Every step is warned of (FMI 2.0: the logger is called with every fmi2Warning):
+    # the message once per kind, then a line that it still holds.
+    steps = round(0.6 / (10 * h))
+    assert sum("fmi2DoStep: at t = " in x for x in warnings) >= steps - 1, (len(warnings), steps)
 
 
 @pytest.mark.parametrize("vehicle", VEHICLES)

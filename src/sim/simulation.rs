@@ -841,6 +841,12 @@ impl Simulation {
         Some(self.sample_of_wheelset(self.wheelsets.get(k)?))
     }
 
+    /// Wheelset `k`'s sample at the current time if it was already computed (a master
+    /// read the outputs since the state last changed), without computing it.
+    pub fn computed_sample_of(&self, k: usize) -> Option<Sample> {
+        self.wheelsets.get(k)?.cached.get()
+    }
+
     fn sample_of_wheelset(&self, w: &Wheelset) -> Sample {
         if let Some(s) = w.cached.get() {
             return s;

@@ -301,9 +301,20 @@ impl Model for FmuModel {
                 let refs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
                 for (k, r) in refs.take(n).enumerate() {
                     let z = self.datum.apply(k, [v(r[0]), v(r[1])]);
+                    // The forces the master read at this point before the new heights (a
+                    // Jacobi master reads the outputs first), and those it reads after.
+                    // A master that sets the heights first (a sequential loop) has read
+                    // nothing yet: no jump to measure, and no contact computed for it.
+                    let forces = |s: Sample| [s.contact[0].force, s.contact[1].force];
+                    let before = sim.computed_sample_of(k).map(forces);
                     wheel_inputs(sim, k, r, z, values, changed)?;
                     if changed.contains(&r[0]) || changed.contains(&r[1]) {
                         self.watch.coupled();
+                        if let Some(b) = before
+                            && let Some(a) = sim.sample_of(k).map(forces)
+                        {
+                            self.watch.heights_given(k, b, a);
+                        }
                     }
                     if changed.contains(&r[2]) {
                         let radius = sim.scenario().wheel_radius;
@@ -514,6 +525,7 @@ impl Model for FmuModel {
                 .collect();
             let load = sim.static_load()[0].max(sim.static_load()[1]);
             let chatter = self.watch.forces_at_point(&forces, load);
+            let jump = self.watch.take_jump(load);
             let held = !sim.wheelsets().iter().any(|w| match w.vehicle() {
                 VehicleState::External { rates, .. } => rates.moves(),
                 _ => false,
@@ -530,6 +542,24 @@ impl Model for FmuModel {
                      what an explicit exchange of the stiff contact tolerates; use the \
                      track's step solver.step = {} s, or the axle-box interface (interface = \
                      axle_box) for a vehicle model that steps at a millisecond",
+                        num(self.last_step),
+                        num(sim.dt())
+                    ),
+                ))
+            } else if let Some((j, name)) = jump {
+                Some((
+                    "contact exchange",
+                    format!(
+                        "at t = {time} s {name} jumped by {} N ({:.0} % of the static load) when \
+                     the wheel heights of this communication point came in: the heights the \
+                     vehicle returns are far from those the track held over the step, so the \
+                     contact exchange chatters and its forces are numerical; the \
+                     communication step {} s ({ratio:.1} track steps) is beyond what an \
+                     explicit exchange of the stiff contact tolerates; use the track's step \
+                     solver.step = {} s, or the axle-box interface (interface = axle_box) for \
+                     a vehicle model that steps at a millisecond",
+                        num(j),
+                        100.0 * j / load,
                         num(self.last_step),
                         num(sim.dt())
                     ),

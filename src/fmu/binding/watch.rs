@@ -29,6 +29,10 @@ pub(super) const INTERPOLATED_STEPS: f64 = 5.5;
 const CHATTER_RUN: u32 = 6;
 const CHATTER_JUMP: f64 = 0.1;
 
+/// A contact force that jumps by more than this fraction of the static load when the
+/// new wheel heights come in: the exchange does not resolve the contact.
+const JUMP_LIMIT: f64 = 0.2;
+
 /// The axle's rate may differ from the track's `V / R_w` by this fraction (or by
 /// [`RATE_FLOOR`]) before the watch warns.
 const RATE_TOLERANCE: f64 = 0.01;
@@ -60,6 +64,9 @@ pub(super) struct ContactWatch {
     rate: Option<String>,
     /// The master has set wheel heights: there is an exchange to watch.
     coupled: bool,
+    /// The largest jump of a contact force (N) when new wheel heights came in since the
+    /// last step, and the wheel's name.
+    jump: Option<(f64, String)>,
 }
 
 impl ContactWatch {
@@ -70,7 +77,32 @@ impl ContactWatch {
             rotations: vec![None; wheelsets],
             rate: None,
             coupled: false,
+            jump: None,
         }
+    }
+
+    /// Wheelset `k`'s contact forces (N) just before and after new wheel heights came
+    /// in at a communication point.
+    pub(super) fn heights_given(&mut self, k: usize, before: [f64; 2], after: [f64; 2]) {
+        for s in 0..2 {
+            let d = (after[s] - before[s]).abs();
+            if self.jump.as_ref().is_none_or(|(j, _)| d > *j) {
+                let side = if s == 0 { "left" } else { "right" };
+                let name = if k == 0 {
+                    format!("contact.{side}.force")
+                } else {
+                    format!("wheelset[{}].contact.{side}.force", k + 1)
+                };
+                self.jump = Some((d, name));
+            }
+        }
+    }
+
+    /// The largest jump of the communication point just past when it passed
+    /// [`JUMP_LIMIT`] of the static load `load` (N): the jump (N) and the force's name;
+    /// the jump is forgotten.
+    pub(super) fn take_jump(&mut self, load: f64) -> Option<(f64, String)> {
+        self.jump.take().filter(|(j, _)| *j > JUMP_LIMIT * load)
     }
 
     /// The master set wheel heights.
