@@ -146,18 +146,22 @@ impl Case {
         if self.half_car { 2 } else { 1 }
     }
 
+    /// The bogie's critical step (s).
+    fn critical(&self) -> f64 {
+        if self.half_car {
+            self.h_params.critical_time_step()
+        } else {
+            self.p.critical_time_step()
+        }
+    }
+
     /// The cut model at communication step `h` (s) under a Jacobi or sequential master.
     fn run(&self, jacobi: bool, h: f64) -> Outcome {
         let mut sim = Simulation::new(&self.cut).map_err(|e| e.to_string())?;
         let dt = sim.dt();
         let per = (h / dt).round().max(1.0) as u64;
         let h = per as f64 * dt;
-        let critical = if self.half_car {
-            self.h_params.critical_time_step()
-        } else {
-            self.p.critical_time_step()
-        };
-        let sub = (h / (5e-4f64).min(0.4 * critical)).ceil() as usize;
+        let sub = (h / (5e-4f64).min(0.4 * self.critical())).ceil() as usize;
         let hs = h / sub as f64;
         let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
         let mut above = if self.half_car {
@@ -232,10 +236,10 @@ impl Case {
     }
 
     /// The largest communication step (s) up to 20 ms below which every step of a
-    /// geometric scan (ratio 1.1 from 0.1 ms) keeps the run usable: the history
-    /// within 10 % of the static load.
+    /// geometric scan (ratio 1.1 from 0.1 ms) keeps the run stable: it does not diverge
+    /// and its history stays within half the static load.
     fn limit(&self, jacobi: bool) -> f64 {
-        let usable = |h: f64| matches!(self.run(jacobi, h), Ok((_, d)) if d < 10.0);
+        let usable = |h: f64| matches!(self.run(jacobi, h), Ok((_, d)) if d < 50.0);
         let mut h = 1e-4;
         while h <= 20e-3 {
             if !usable(h * 1.1) {
@@ -281,7 +285,7 @@ fn main() {
             "roll-plane vehicle"
         };
         if limits {
-            println!("{name}: largest usable communication step (ms), {duration} s");
+            println!("{name}: largest stable communication step (ms), {duration} s");
             println!(
                 "| K_1 (MN/m) | C_1 (kN s/m) | sequential: measured / estimated | Jacobi: measured / estimated |"
             );

@@ -375,7 +375,9 @@ def run_half_car_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, b
     axle_box = AXLE_BOX + trailing(2, AXLE_BOX)
     forces = FORCES + trailing(2, FORCES)
     try:
-        half_car_handshake(track, bogie, dict(track_params or {}, interface=2),
+        # vehicle.model = half_car: the track carries the bogie's pitching side frames,
+        # shared by the two wheelsets, over each step.
+        half_car_handshake(track, bogie, dict(track_params or {}, interface=2, **{"vehicle.model": 2}),
                            dict(bogie_params or {}, interface=2))
         bogie.fmu.exitInitializationMode()
         track.fmu.exitInitializationMode()
