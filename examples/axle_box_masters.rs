@@ -223,15 +223,15 @@ impl Case {
     fn estimate(&self) -> ExchangeLimits {
         let sim = Simulation::new(&self.cut).unwrap();
         let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
+        let base = (5e-4f64).min(0.4 * self.critical());
         if self.half_car {
-            let mut b = SprungHalfCar::new(self.h_params, 5e-4).unwrap();
+            let mut b = SprungHalfCar::new(self.h_params, base).unwrap();
             b.set_static(boxes).unwrap();
-            b.exchange_limits(boxes, 5e-4, CONTACT_STIFFNESS).unwrap()
+            b.exchange_limits(boxes, base, CONTACT_STIFFNESS).unwrap()
         } else {
-            let mut b = SprungBogie::new(self.p, 5e-4).unwrap();
+            let mut b = SprungBogie::new(self.p, base).unwrap();
             b.set_static(boxes[0]).unwrap();
-            b.exchange_limits(boxes[0], 5e-4, CONTACT_STIFFNESS)
-                .unwrap()
+            b.exchange_limits(boxes[0], base, CONTACT_STIFFNESS).unwrap()
         }
     }
 
