@@ -312,8 +312,13 @@ fn var_spec(rust: &mut String, table: &Table, id: &str, v: &FmuVar) {
                 .find(|x| x.name == item)
                 .unwrap_or_else(|| panic!("usedWhen: {item} is no item of {ty}"))
                 .value;
+            let items = table.enums[&ty]
+                .iter()
+                .map(|x| format!("{} = {}", x.value, x.name))
+                .collect::<Vec<_>>()
+                .join(", ");
             format!(
-                "Some(UsedWhen {{ selector: {sel}, value: {value}.0, text: {:?} }})",
+                "Some(UsedWhen {{ selector: {sel}, value: {value}.0, text: {:?}, items: {items:?} }})",
                 format!("{selector} = {item} ({value})")
             )
         }

@@ -231,7 +231,8 @@ impl Case {
         } else {
             let mut b = SprungBogie::new(self.p, base).unwrap();
             b.set_static(boxes[0]).unwrap();
-            b.exchange_limits(boxes[0], base, CONTACT_STIFFNESS).unwrap()
+            b.exchange_limits(boxes[0], base, CONTACT_STIFFNESS)
+                .unwrap()
         }
     }
 

@@ -1096,6 +1096,36 @@ def test_the_axle_box_step_estimate_covers_the_primary_springs_and_dampers(paths
     b.close()
 
 
+@pytest.mark.parametrize("interface", [1, 2])
+def test_a_vehicle_its_partner_does_not_carry_at_rest_is_warned_of(paths, interface):
+    # The new user's heavier bogie (a 30 t car body: 155,979 N per wheel) on a track that
+    # carries the default 107,664.75 N: the forces that drive the first step are a
+    # third off its forces at rest, and the message names TrackContact's static_load.
+    log = Log()
+    b = wf.Unit(paths["HalfCarBogie"], "b", callbacks=log.callbacks)
+    b.fmu.setupExperiment(startTime=0.0)
+    b.set_parameters({"interface": interface, "vehicle.carbody_mass": 30000.0})
+    b.fmu.enterInitializationMode()
+    # What a track with the default static load hands it at rest: contact forces of
+    # 107,664.75 N, or primary forces of 102,171.15 N (less the wheelset's weight).
+    inputs = ["contact.left.force", "contact.right.force"] if interface == 1 else \
+        ["axle_box.left.force", "axle_box.right.force"]
+    inputs += ["wheelset[2]." + n for n in inputs]
+    b.set(inputs, [107664.75 if interface == 1 else 102171.15] * 4)
+    b.fmu.exitInitializationMode()
+    load = b.get("static_load.left")[0]
+    assert load == pytest.approx(155979, abs=1)
+    assert step_status(b, 0.0, 1e-3) == 1
+    assert f"static_load.left = {load:g} N" in log.text() and "off the" in log.text(), log.text()
+    assert step_status(b, 1e-3, 1e-3) == 0
+    b.close()
+    # Carried at rest: no warning.
+    log = Log()
+    b = initialised(paths, "HalfCarBogie", log=log, params={"interface": interface})
+    assert step_status(b, 0.0, 1e-3) == 0 and "static_load" not in log.text()
+    b.close()
+
+
 def test_inputs_of_the_interface_not_in_use_are_refused(paths):
     # Issue 24: a coupling wired for the other interface ran with fmi2OK.
     # After initialisation, at the set.
@@ -1190,10 +1220,10 @@ def test_a_braked_pair_keeps_its_flats_where_the_track_carries_the_wheels(paths)
     reference = braked_coupled_system(paths)
     assert peak == pytest.approx(reference, rel=1e-9), (peak, reference)
     assert reference < 1.01 * 107664.75
-    assert "wheel.rotation turned at" not in text
+    assert "wheel.rotation turned by" not in text
     peak, text = braked_pair(paths, False)
     assert peak > 1.2 * reference, peak
-    assert "wheel.rotation turned at 4" in text and "give the vehicle the speed the track has" in text, text
+    assert "wheel.rotation turned by" in text and "give the vehicle the speed the track has" in text, text
 
 
 @pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])

@@ -59,6 +59,8 @@ pub struct UsedWhen {
     pub value: f64,
     /// The condition in words, with the selector's name: `interface = axle_box (2)`.
     pub text: &'static str,
+    /// The selector's items: `1 = contact, 2 = axle_box`.
+    pub items: &'static str,
 }
 
 /// One FMU: identity, its modelDescription.xml and its variables.

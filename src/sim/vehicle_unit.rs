@@ -85,6 +85,9 @@ pub struct VehicleUnit {
     /// The held forces of each wheelset (N); the second is unused by the roll-plane
     /// vehicle.
     force: Quad,
+    /// The forces that hold the vehicle at rest (N): contact forces, or primary forces
+    /// with the axle-box interface.
+    rest: Quad,
     extremes: [ForceExtremes; 2],
     /// The axle rotation (rad) at `since` (s), from which it turns at the speed held
     /// since ([`VehicleUnit::set_speed`]).
@@ -176,6 +179,7 @@ impl VehicleUnit {
             body,
             clock: Clock::new(dt, Stepping::Substeps),
             force,
+            rest: force,
             extremes: force.map(ForceExtremes::at),
             rotation_ref: 0.0,
             since: 0.0,
@@ -381,6 +385,13 @@ impl VehicleUnit {
     pub fn is_axle_box(&self) -> bool {
         matches!(self.body, Body::Sprung { .. } | Body::SprungHalfCar(_))
     }
+    /// The forces `[left, right]` (N) of wheelset `k` that hold the vehicle at rest
+    /// (contact, or primary with the axle-box interface); `None` for a wheelset the
+    /// vehicle does not have.
+    pub fn rest_forces_of(&self, k: usize) -> Option<[f64; 2]> {
+        (k < self.wheelsets()).then(|| self.rest[k])
+    }
+
     /// The held forces `[left, right]` (N) of wheelset `k` (contact, or primary with the
     /// axle-box interface); `None` for a wheelset the vehicle does not have.
     pub fn held_forces_of(&self, k: usize) -> Option<[f64; 2]> {

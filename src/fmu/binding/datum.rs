@@ -15,13 +15,16 @@ use crate::error::{Error, out_of_range};
 
 /// The offsets of the displacement inputs of each wheelset `[left, right]` (m), the
 /// same for both sides' wheel heights (contact interface) or side frames (axle-box
-/// interface), followed until the first step and fixed there.
+/// interface), followed until the first step and fixed there; a wheelset whose inputs
+/// were not given by then takes the first ones it gets as its static state.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct InputDatum {
     /// Offsets are taken (`inputs.datum = first_step`); otherwise always 0.
     relative: bool,
-    /// The first step was taken: the offsets are fixed.
-    fixed: bool,
+    /// Per wheelset: inputs were given (before the first step, or since).
+    given: Vec<bool>,
+    /// Per wheelset: the offsets are fixed.
+    fixed: Vec<bool>,
     /// The static displacements the first inputs stand for (m).
     statics: Vec<[f64; 2]>,
     /// Added to each input (m).
@@ -32,50 +35,63 @@ impl InputDatum {
     /// The datum of a track whose displacement inputs rest at `statics` (m, one pair
     /// per wheelset); `relative`: `inputs.datum = first_step`.
     pub(super) fn new(relative: bool, statics: Vec<[f64; 2]>) -> InputDatum {
-        let offsets = vec![[0.0; 2]; statics.len()];
+        let n = statics.len();
         InputDatum {
             relative,
-            fixed: false,
+            given: vec![false; n],
+            fixed: vec![false; n],
             statics,
-            offsets,
+            offsets: vec![[0.0; 2]; n],
         }
     }
 
-    /// The displacements (m) the track takes for wheelset `k`'s inputs `raw` (m): before
-    /// the first step the static ones (the offsets follow the inputs), after it the
-    /// inputs moved by the offsets fixed then.
+    /// The displacements (m) the track takes for wheelset `k`'s inputs `raw` (m): until
+    /// its offsets are fixed the static ones (the offsets follow the inputs), then the
+    /// inputs moved by the offsets fixed.
     pub(super) fn apply(&mut self, k: usize, raw: [f64; 2]) -> [f64; 2] {
         if !self.relative || k >= self.statics.len() {
             return raw;
         }
-        if !self.fixed {
+        if !self.fixed[k] {
+            self.given[k] = true;
             self.offsets[k] = [0, 1].map(|s| self.statics[k][s] - raw[s]);
             return self.statics[k];
         }
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
     }
 
-    /// Whether the inputs stand for the static state whatever they are (before the first
-    /// step, with `first_step`).
-    pub(super) fn follows(&self) -> bool {
-        self.relative && !self.fixed
+    /// Whether wheelset `k`'s inputs stand for the static state whatever they are (not
+    /// fixed yet, with `first_step`).
+    pub(super) fn follows(&self, k: usize) -> bool {
+        self.relative && !self.fixed.get(k).copied().unwrap_or(true)
     }
 
-    /// The first step is taken: the offsets stay as they are.
+    /// A step is taken: the offsets of every wheelset whose inputs were given stay as
+    /// they are.
     pub(super) fn fix(&mut self) {
-        self.fixed = true;
+        for (f, g) in self.fixed.iter_mut().zip(&self.given) {
+            *f |= *g;
+        }
     }
 
     /// Values of [`InputDatum::state`].
     pub(super) fn state_len(&self) -> usize {
-        1 + 2 * self.offsets.len()
+        4 * self.offsets.len()
     }
 
-    /// `[fixed (0 or 1), offsets (2 per wheelset)]`.
+    /// Per wheelset: given (0 or 1), fixed (0 or 1), the offsets `[left, right]` (m).
     pub(super) fn state(&self) -> Vec<f64> {
-        let mut v = vec![f64::from(u8::from(self.fixed))];
-        v.extend(self.offsets.iter().flatten());
-        v
+        let flag = |b: bool| f64::from(u8::from(b));
+        (0..self.offsets.len())
+            .flat_map(|k| {
+                [
+                    flag(self.given[k]),
+                    flag(self.fixed[k]),
+                    self.offsets[k][0],
+                    self.offsets[k][1],
+                ]
+            })
+            .collect()
     }
 
     /// Restores [`InputDatum::state`].
@@ -83,22 +99,25 @@ impl InputDatum {
     /// Errors: a wrong length, a flag that is not 0 or 1, an offset beyond 1 m or not
     /// finite.
     pub(super) fn restore(&mut self, v: &[f64]) -> Result<(), Error> {
-        if v.len() != self.state_len()
-            || !(v[0] == 0.0 || v[0] == 1.0)
-            || v[1..].iter().any(|x| x.is_nan() || x.abs() > 1.0)
-        {
+        let flag = |x: f64| x == 0.0 || x == 1.0;
+        let ok = v.len() == self.state_len()
+            && v.chunks(4).all(|c| {
+                flag(c[0]) && flag(c[1]) && c[2..].iter().all(|x| x.is_finite() && x.abs() <= 1.0)
+            });
+        if !ok {
             return Err(out_of_range(
                 "state: input datum",
                 v.len() as f64,
                 format!(
-                    "{} values: a flag 0 or 1, then offsets within 1 m",
+                    "{} values: per wheelset two flags 0 or 1, then offsets within 1 m",
                     self.state_len()
                 ),
             ));
         }
-        self.fixed = v[0] == 1.0;
-        for (o, pair) in self.offsets.iter_mut().zip(v[1..].chunks(2)) {
-            *o = [pair[0], pair[1]];
+        for (k, c) in v.chunks(4).enumerate() {
+            self.given[k] = c[0] == 1.0;
+            self.fixed[k] = c[1] == 1.0;
+            self.offsets[k] = [c[2], c[3]];
         }
         Ok(())
     }
@@ -123,8 +142,22 @@ mod tests {
         let mut e = InputDatum::new(true, vec![[0.0; 2]]);
         e.restore(&d.state()).unwrap();
         assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3]), z);
-        assert!(e.restore(&[2.0, 0.0, 0.0]).is_err());
+        assert!(e.restore(&[2.0, 0.0, 0.0, 0.0]).is_err());
         assert!(e.restore(&[1.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn a_wheelset_first_given_after_the_first_step_starts_from_its_static_state() {
+        let mut d = InputDatum::new(true, vec![[-1.5e-3; 2], [-1.6e-3; 2]]);
+        d.apply(0, [-1.38e-3; 2]);
+        d.fix();
+        // Wheelset 2 was not given before the first step: its first input stands for the
+        // static state, and it moves from there after the next step.
+        assert!(d.follows(1) && !d.follows(0));
+        assert_eq!(d.apply(1, [-1.0e-3; 2]), [-1.6e-3; 2]);
+        d.fix();
+        let z = d.apply(1, [-0.9e-3; 2]);
+        assert!((z[0] - -1.5e-3).abs() < 1e-15, "{z:?}");
     }
 
     #[test]

@@ -71,6 +71,47 @@ fn wheel_inputs(
     Ok(())
 }
 
+/// Why the forces that drove a vehicle's first step do not hold it at rest (more than
+/// 1 % off, wheel by wheel), in words; `None` when they do.
+fn off_rest(u: &VehicleUnit) -> Option<String> {
+    let (names, partner) = if u.is_axle_box() {
+        (
+            "axle_box.*.force",
+            "TrackContact's static_load.* (and its vehicle.wheelset.*, vehicle.primary.*, gravity) \
+             to this vehicle's",
+        )
+    } else {
+        (
+            "contact.*.force",
+            "TrackContact's static_load.* to this vehicle's",
+        )
+    };
+    let mut worst: Option<(f64, f64, f64)> = None;
+    for k in 0..u.wheelsets() {
+        let (Some(held), Some(rest)) = (u.held_forces_of(k), u.rest_forces_of(k)) else {
+            continue;
+        };
+        for s in 0..2 {
+            let off = (held[s] - rest[s]).abs() / rest[s].abs().max(1.0);
+            if off > 0.01 && worst.is_none_or(|(o, _, _)| off > o) {
+                worst = Some((off, held[s], rest[s]));
+            }
+        }
+    }
+    let (off, held, rest) = worst?;
+    let load = u.static_load();
+    Some(format!(
+        "the {names} that drove the first step ({} N) are {:.1} % off the {} N that hold this \
+         vehicle at rest: its partner does not carry it at rest and it will start moving; \
+         set {partner} (static_load.left = {} N, static_load.right = {} N)",
+        num(held),
+        100.0 * off,
+        num(rest),
+        num(load[0]),
+        num(load[1])
+    ))
+}
+
 /// The refusal of derivatives of value reference `r`.
 fn no_derivative(r: u32) -> Error {
     Error::Unsupported(format!(
@@ -140,6 +181,10 @@ pub struct FmuModel {
     datum: InputDatum,
     /// What TrackContact sees of its exchange at the contact interface.
     watch: ContactWatch,
+    /// The end of the master's last step, in model time (s).
+    master_end: f64,
+    /// A vehicle's first step was checked against its forces at rest.
+    started: bool,
 }
 
 impl FmuModel {
@@ -260,6 +305,8 @@ impl Model for FmuModel {
             last_step: 0.0,
             datum,
             watch,
+            master_end: 0.0,
+            started: false,
         })
     }
 
@@ -318,8 +365,8 @@ impl Model for FmuModel {
                     }
                     if changed.contains(&r[2]) {
                         let radius = sim.scenario().wheel_radius;
-                        self.watch
-                            .rotation_given(k, sim.time(), v(r[2]), sim.position(), radius);
+                        let track = (sim.time(), sim.position(), sim.dt());
+                        self.watch.rotation_given(k, track, v(r[2]), radius);
                     }
                 }
                 Ok(())
@@ -449,9 +496,10 @@ impl Model for FmuModel {
         match &mut self.engine {
             Engine::Sim(sim) => {
                 let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
-                let before = sim.time();
                 sim.advance_to(plan)?;
-                self.last_step = sim.time() - before;
+                // The master's step (its clock, not the track's grid).
+                self.last_step = end - self.master_end;
+                self.master_end = end;
                 self.datum.fix();
                 if self.kind == Kind::CoupledSystem {
                     sim.check_sample()?;
@@ -480,35 +528,45 @@ impl Model for FmuModel {
     /// communication step above [`VehicleUnit::axle_box_step_limit`].
     fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
         if let Engine::Vehicle(u) = &self.engine {
+            // The forces that drove the first step against those that hold this vehicle
+            // at rest: a partner that does not carry it at rest.
+            if !self.started {
+                self.started = true;
+                if let Some(w) = off_rest(u) {
+                    return Some(("static load", w));
+                }
+            }
             let e = u.exchange_limits()?;
             let h = self.last_step;
             return (h > e.jacobi).then(|| {
-                let which = if h > e.sequential {
-                    "under any master"
-                } else {
-                    "under a Jacobi master (OSP libcosim, ecos: every unit from the same \
-                     communication point); a sequential one that steps TrackContact first and \
-                     hands this unit its primary.*.mean_force stays stable to that step"
-                };
-                (
-                    "axle-box step",
+                let message = if h > e.sequential {
                     format!(
-                        "at t = {time} s the communication step {} s is above {} s, the largest \
-                     at which the axle-box exchange stays stable {which} (estimated from the \
-                     exchange's amplification matrix: the primary springs and dampers \
-                     vehicle.primary.* exchanged explicitly against the side frames' inertia; \
-                     {} s under a sequential master): expect it to diverge; use steps of at \
-                     most {} s",
+                        "at t = {time} s the communication step {} s is above {} s, the \
+                         largest at which the axle-box exchange stays stable under any master \
+                         (estimated from the exchange's amplification matrix with the primary \
+                         springs and dampers vehicle.primary.* and the side frames' inertia): \
+                         expect it to diverge; use steps of at most {} s",
                         num(h),
-                        num(if h > e.sequential {
-                            e.sequential
-                        } else {
-                            e.jacobi
-                        }),
                         num(e.sequential),
                         num(e.jacobi)
-                    ),
-                )
+                    )
+                } else {
+                    format!(
+                        "at t = {time} s the communication step {} s is above {} s, the \
+                         largest at which the axle-box exchange stays stable under a Jacobi \
+                         master (OSP libcosim, ecos: every unit steps from the same point), \
+                         estimated from the exchange's amplification matrix with the primary \
+                         springs and dampers vehicle.primary.* and the side frames' inertia; \
+                         under such a master expect it to diverge and use steps of at most {} \
+                         s. A sequential master that steps TrackContact first and hands this \
+                         unit its primary.*.mean_force stays stable to {} s",
+                        num(h),
+                        num(e.jacobi),
+                        num(e.jacobi),
+                        num(e.sequential)
+                    )
+                };
+                ("axle-box step", message)
             });
         }
         let Engine::Sim(sim) = &self.engine else {
@@ -560,6 +618,19 @@ impl Model for FmuModel {
                      a vehicle model that steps at a millisecond",
                         num(j),
                         100.0 * j / load,
+                        num(self.last_step),
+                        num(sim.dt())
+                    ),
+                ))
+            } else if self.watch.is_coupled() && (ratio - ratio.round()).abs() > 1e-3 {
+                Some((
+                    "contact step grid",
+                    format!(
+                        "at t = {time} s the communication step {} s is {ratio:.3} track steps \
+                     (solver.step = {} s): the track steps on its own grid, so the wheel \
+                     heights and contact forces meet at other times than the master's (the \
+                     peak of the reference flat +4.7 % at half a track step); use a whole \
+                     number of solver.step",
                         num(self.last_step),
                         num(sim.dt())
                     ),
@@ -644,6 +715,9 @@ impl Model for FmuModel {
         }
         self.datum = restored;
         self.watch.restart();
+        if let Engine::Sim(sim) = &self.engine {
+            self.master_end = sim.time();
+        }
         Ok(())
     }
 
@@ -751,7 +825,7 @@ impl Model for FmuModel {
         }
         // Before the first step the wheel heights stand for the static state
         // (`inputs.datum = first_step`): the forces do not follow them yet.
-        if which != 2 && self.datum.follows() {
+        if which != 2 && self.datum.follows(ku) {
             return Ok(0.0);
         }
         let wheel = &sim

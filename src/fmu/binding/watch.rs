@@ -33,10 +33,13 @@ const CHATTER_JUMP: f64 = 0.1;
 /// new wheel heights come in: the exchange does not resolve the contact.
 const JUMP_LIMIT: f64 = 0.2;
 
-/// The axle's rate may differ from the track's `V / R_w` by this fraction (or by
-/// [`RATE_FLOOR`]) before the watch warns.
+/// The angle the axle turned may differ from the track's travel over the wheel radius
+/// by this fraction (plus [`RATE_FLOOR`] rad/s over the window and the grid's offset)
+/// before the watch warns; compared over windows of at least [`RATE_WINDOW`] track
+/// steps.
 const RATE_TOLERANCE: f64 = 0.01;
 const RATE_FLOOR: f64 = 0.05;
+const RATE_WINDOW: f64 = 64.0;
 
 /// One wheel's contact forces at the communication points.
 #[derive(Debug, Clone, Copy, Default)]
@@ -115,15 +118,18 @@ impl ContactWatch {
         self.coupled
     }
 
-    /// Wheelset `k`'s axle angle `angle` (rad) given at `time` (s), the track at
-    /// `position` (m) then, of wheel radius `radius` (m): its rate since the last one
-    /// against the track's mean `V / R_w` over the same time.
+    /// Wheelset `k`'s axle angle `angle` (rad) given when the track is at `time` (s)
+    /// and `position` (m), its step `dt` (s), wheel radius `radius` (m): the angle
+    /// turned since the last comparison against the track's travel over the radius, once
+    /// at least [`RATE_WINDOW`] track steps have passed. The track's time and position
+    /// lie on its own grid and the angle on the master's clock (at most a track step
+    /// apart); over the window that offset is allowed for, and an angle given modulo a
+    /// turn is unwrapped.
     pub(super) fn rotation_given(
         &mut self,
         k: usize,
-        time: f64,
+        (time, position, dt): (f64, f64, f64),
         angle: f64,
-        position: f64,
         radius: f64,
     ) {
         let Some(slot) = self.rotations.get_mut(k) else {
@@ -134,33 +140,41 @@ impl ContactWatch {
             angle,
             position,
         };
-        if let Some(last) = *slot {
-            let dt = time - last.time;
-            if dt > 0.0 {
-                let rate = (angle - last.angle) / dt;
-                let expected = (position - last.position) / (radius * dt);
-                if (rate - expected).abs() > (RATE_TOLERANCE * expected.abs()).max(RATE_FLOOR) {
-                    let name = if k == 0 {
-                        "wheel.rotation".to_string()
-                    } else {
-                        format!("wheelset[{}].wheel.rotation", k + 1)
-                    };
-                    self.rate = Some(format!(
-                        "{name} turned at {} rad/s from t = {} s to {} s, but the track moved \
-                         at {} m/s there, which rolls the axle at {} rad/s (speed / \
-                         wheel.radius): the flats meet the rail where {name} puts them, so \
-                         they hit it at the wrong places; give the vehicle the speed the track \
-                         has (RollPlaneVehicle's and HalfCarBogie's speed is an input)",
-                        num(rate),
-                        num(last.time),
-                        num(time),
-                        num(expected * radius),
-                        num(expected)
-                    ));
-                } else {
-                    self.rate = None;
-                }
-            }
+        let Some(last) = *slot else {
+            *slot = Some(now);
+            return;
+        };
+        let span = time - last.time;
+        if span < RATE_WINDOW * dt {
+            return;
+        }
+        let rolled = (position - last.position) / radius;
+        let turned = angle - last.angle;
+        // The nearest multiple of a turn: a partner may wrap its angle.
+        let off = turned - rolled;
+        let off = off - std::f64::consts::TAU * (off / std::f64::consts::TAU).round();
+        let speed = (position - last.position).abs() / span;
+        let grid = 2.0 * speed * dt / radius;
+        if off.abs() > RATE_TOLERANCE * rolled.abs() + grid + RATE_FLOOR * span {
+            let name = if k == 0 {
+                "wheel.rotation".to_string()
+            } else {
+                format!("wheelset[{}].wheel.rotation", k + 1)
+            };
+            self.rate = Some(format!(
+                "{name} turned by {} rad from t = {} s to {} s, but the track moved {} m \
+                 there, which rolls the axle by {} rad (speed / wheel.radius): the flats \
+                 meet the rail where {name} puts them, so they hit it at the wrong places; \
+                 give the vehicle the speed the track has (RollPlaneVehicle's and \
+                 HalfCarBogie's speed is an input)",
+                num(turned),
+                num(last.time),
+                num(time),
+                num(position - last.position),
+                num(rolled)
+            ));
+        } else {
+            self.rate = None;
         }
         *slot = Some(now);
     }
@@ -243,18 +257,23 @@ mod tests {
     #[test]
     fn an_axle_that_turns_at_another_rate_than_the_track_rolls_is_named() {
         let mut w = ContactWatch::new(1);
-        let r = 0.42;
+        let (r, dt) = (0.42, 1e-3);
         // The track brakes from 19.44 m/s to 10 m/s, the axle keeps turning at 19.44 / r.
-        w.rotation_given(0, 0.0, 0.0, 0.0, r);
-        w.rotation_given(0, 0.1, 0.1 * 19.44 / r, 1.0, r);
+        w.rotation_given(0, (0.0, 0.0, dt), 0.0, r);
+        // Within the window: nothing compared yet.
+        w.rotation_given(0, (0.05, 0.5, dt), 0.05 * 19.44 / r, r);
+        assert!(w.rate_warning().is_none());
+        w.rotation_given(0, (0.1, 1.0, dt), 0.1 * 19.44 / r, r);
         let m = w.rate_warning().unwrap();
-        assert!(m.starts_with("wheel.rotation turned at 46.28"), "{m}");
+        assert!(m.starts_with("wheel.rotation turned by 4.628"), "{m}");
         assert!(
-            m.contains("moved at 9.99") && m.contains("axle at 23.80"),
+            m.contains("moved 1 m") && m.contains("axle by 2.380"),
             "{m}"
         );
-        // Rolling as the track moves: no warning.
-        w.rotation_given(0, 0.2, 0.1 * 19.44 / r + 1.0 / r, 2.0, r);
-        assert!(w.rate_warning().is_none());
+        // Rolling as the track moves, its angle given modulo a turn and the track's time
+        // and position half a step off the master's: no warning.
+        let a = (0.1 * 19.44 / r + 1.0 / r) % std::f64::consts::TAU;
+        w.rotation_given(0, (0.2 + 0.5 * dt, 2.0 + 0.005, dt), a, r);
+        assert!(w.rate_warning().is_none(), "{:?}", w.rate_warning());
     }
 }

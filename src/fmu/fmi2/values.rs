@@ -33,8 +33,14 @@ impl<M: Model> Instance<M> {
             return self.refuse(
                 Status::Error,
                 format!(
-                    "{call}: variable `{}` (value reference {}) is of type {:?}",
-                    s.name, s.vr, s.ty
+                    "{call}: variable `{}` (value reference {}) is of type {}",
+                    s.name,
+                    s.vr,
+                    match s.ty {
+                        VarType::Real => "Real",
+                        // Written as Integer in the model descriptions.
+                        VarType::Integer | VarType::Enumeration => "Integer",
+                    }
                 ),
             );
         }
@@ -126,12 +132,13 @@ impl<M: Model> Instance<M> {
                 .find(|v| v.vr == w.selector)
                 .map_or("the selector", |v| v.name);
             format!(
-                "`{}` is an input of {} only, but {selector} = {} here, where it would be \
-                 ignored: connect the inputs of the {selector} in use, or set {selector} to \
-                 match the coupling",
+                "`{}` is an input of {} only, but {selector} = {} here ({}), where it \
+                 would be ignored: connect the inputs of the {selector} in use, or set \
+                 {selector} to match the coupling",
                 s.name,
                 w.text,
-                num(now)
+                num(now),
+                w.items
             )
         })
     }
