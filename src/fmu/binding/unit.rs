@@ -525,7 +525,9 @@ impl Model for FmuModel {
     /// When the wheel is within [`END_ZONE_SPANS`] sleeper spans of the fixed rail end,
     /// where the end's reflections raise the impact forces (by 20 to 35 % within the
     /// last span, table 4.4); for the vehicles with the axle-box interface, a
-    /// communication step above [`VehicleUnit::axle_box_step_limit`].
+    /// communication step above the Jacobi estimate of [`VehicleUnit::exchange_limits`]; for
+    /// TrackContact at the contact interface, what its contact watch sees (`watch.rs`); for a vehicle's
+    /// first step, forces off its forces at rest.
     fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
         if let Engine::Vehicle(u) = &self.engine {
             // The forces that drove the first step against those that hold this vehicle
