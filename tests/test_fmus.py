@@ -1254,3 +1254,51 @@ def test_each_fmu_carries_its_icon(paths, name):
         img = mpimg.imread(io.BytesIO(z.read("model.png")), format="png")
     assert img.shape == (128, 128, 4)
     assert (img[:, :, 3] > 0).mean() > 0.15  # a drawing, not an empty picture
+
+
+# ------------------------------------------------------------------ issue 25
+
+RTLD_GLOBAL_SCRIPT = r'''
+import ctypes, os, sys, tempfile, zipfile
+from fmpy import read_model_description
+from fmpy.fmi2 import (fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
+                       fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE)
+paths = dict(arg.split("=", 1) for arg in sys.argv[1:])
+msgs = []
+cb = fmi2CallbackFunctions()
+cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: msgs.append(m.decode()))
+cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(lambda n, s: None)
+cb.freeMemory = fmi2CallbackFreeMemoryTYPE(lambda p: None)
+libs = []
+for name, path in paths.items():
+    d = tempfile.mkdtemp()
+    with zipfile.ZipFile(path) as z:
+        z.extractall(d)
+    lib = ctypes.CDLL(os.path.join(d, "binaries", "linux64", name + ".so"), mode=ctypes.RTLD_GLOBAL)
+    libs.append((name, lib, read_model_description(path).guid, d))
+for name, lib, guid, d in libs:
+    lib.fmi2Instantiate.restype = ctypes.c_void_p
+    c = lib.fmi2Instantiate(b"x", 1, guid.encode(), ("file://" + d + "/resources").encode(),
+                            ctypes.byref(cb), 0, 0)
+    if not c:
+        print(name, "refused:", msgs[-1:])
+        continue
+    c = ctypes.c_void_p(c)
+    steps = [lib.fmi2SetupExperiment(c, 0, ctypes.c_double(0.0), ctypes.c_double(0.0), 0),
+             lib.fmi2EnterInitializationMode(c), lib.fmi2ExitInitializationMode(c),
+             lib.fmi2DoStep(c, ctypes.c_double(0.0), ctypes.c_double(1e-3), 1)]
+    lib.fmi2FreeInstance(c)
+    print(name, "statuses", steps)
+'''
+
+
+def test_every_fmu_instantiates_with_the_libraries_loaded_rtld_global(paths):
+    # Issue 25: with RTLD_GLOBAL, dladdr on an exported function named the first library
+    # loaded, so the other three refused their own GUIDs. All four in one process.
+    r = subprocess.run([sys.executable, "-c", RTLD_GLOBAL_SCRIPT] + [f"{n}={p}" for n, p in paths.items()],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert len(lines) == 4, r.stdout
+    for line in lines:
+        assert line.endswith("statuses [0, 0, 0, 0]"), r.stdout

@@ -15,6 +15,13 @@ pub fn kind_of_binary(path: &str) -> Option<Kind> {
         .find(|k| k.table().model_identifier == stem)
 }
 
+/// A byte of this binary's own data: its address lies in this loaded object whatever
+/// the loader. (The address of an exported function does not: a host that loads several
+/// FMU libraries with `RTLD_GLOBAL` resolves an exported name to the first library
+/// loaded, so `dladdr` on it named that library for all of them.) Not exported, so every
+/// reference to it binds inside this object.
+static ANCHOR: u8 = 0;
+
 /// Path of the loaded object that holds this code (the FMU's shared library, or the
 /// executable that links the crate), from the dynamic loader.
 ///
@@ -24,7 +31,7 @@ pub fn loaded_binary() -> Option<String> {
     #[cfg(unix)]
     {
         let mut info: libc::Dl_info = unsafe { std::mem::zeroed() };
-        let addr = super::exports::fmi2Instantiate as *const c_void;
+        let addr = std::hint::black_box(&ANCHOR) as *const u8 as *const c_void;
         if unsafe { libc::dladdr(addr, &mut info) } != 0 && !info.dli_fname.is_null() {
             return c_str(info.dli_fname);
         }
