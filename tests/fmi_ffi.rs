@@ -531,3 +531,96 @@ fn free_instance_frees_its_states_and_null_components_are_refused() {
         // Dropped: fmi2FreeInstance frees the five states (valgrind: no leak).
     }
 }
+
+/// `fmi2Instantiate` with the raw bytes `name` (NUL-terminated by this function) as the
+/// instance name: the component (null when refused) and the log.
+fn instantiate_named(name: Option<&[u8]>) -> (fmi2Component, Box<Log>) {
+    let log = Box::<Log>::default();
+    let cb = callbacks(&log);
+    let guid = CString::new(TRACK_CONTACT.guid).unwrap();
+    let owned = name.map(|n| CString::new(n).unwrap());
+    let ptr = owned.as_ref().map_or(std::ptr::null(), |n| n.as_ptr());
+    let c = unsafe { fmi2Instantiate(ptr, 1, guid.as_ptr(), c"".as_ptr(), &cb, 0, 0) };
+    (c, log)
+}
+
+#[test]
+fn instance_names_are_non_empty_and_logged_as_given() {
+    // Issue 25: FMI 2.0 requires a non-empty instance name; blanks are no name either.
+    for name in [None, Some(&b""[..]), Some(&b"   "[..])] {
+        let (c, log) = instantiate_named(name);
+        assert!(c.is_null(), "{name:?}");
+        assert!(
+            log.last().contains("FMI 2.0 requires a non-empty name"),
+            "{}",
+            log.last()
+        );
+    }
+    // A name that is not UTF-8 is logged with its bytes escaped, not replaced.
+    let (c, log) = instantiate_named(Some(b"wheel\xff\xfe1"));
+    assert!(!c.is_null());
+    let f = Fmu {
+        c,
+        log,
+        table: &TRACK_CONTACT,
+    };
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(f.c, 0, 0.0, 0.0, 1, -1.0), 3);
+    }
+    let records = f.log.records.lock().unwrap().clone();
+    let instance = &records.last().unwrap().instance;
+    assert_eq!(instance, "wheel\\xff\\xfe1");
+}
+
+#[test]
+fn an_empty_experiment_is_accepted_and_a_larger_state_buffer_too() {
+    // Issue 25: stopTime == startTime is a legal (empty) experiment; a serialization
+    // buffer larger than the announced size is legal, and the padded bytes deserialize.
+    let f = Fmu::new(&TRACK_CONTACT, "e");
+    unsafe {
+        assert_eq!(
+            fmi2SetupExperiment(f.c, 0, 0.0, 0.0, 1, 0.0),
+            0,
+            "{}",
+            f.log.text()
+        );
+    }
+    let f = Fmu::initialised(&TRACK_CONTACT, "s");
+    assert_eq!(f.step(0.0, 1e-4), 0);
+    let mut state: fmi2FMUstate = std::ptr::null_mut();
+    let mut size = 0usize;
+    unsafe {
+        assert_eq!(fmi2GetFMUstate(f.c, &mut state), 0);
+        assert_eq!(fmi2SerializedFMUstateSize(f.c, state, &mut size), 0);
+        let mut buffer = vec![7 as fmi2Byte; size + 100];
+        assert_eq!(
+            fmi2SerializeFMUstate(f.c, state, buffer.as_mut_ptr(), buffer.len()),
+            0,
+            "{}",
+            f.log.text()
+        );
+        assert!(buffer[size..].iter().all(|&b| b == 0));
+        let mut back: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(
+            fmi2DeSerializeFMUstate(f.c, buffer.as_ptr(), buffer.len(), &mut back),
+            0,
+            "{}",
+            f.log.text()
+        );
+        // Damage after the state is still refused.
+        buffer[size + 50] = 1;
+        let mut bad: fmi2FMUstate = std::ptr::null_mut();
+        assert_eq!(
+            fmi2DeSerializeFMUstate(f.c, buffer.as_ptr(), buffer.len(), &mut bad),
+            3
+        );
+        // Too small a buffer is refused.
+        assert_eq!(
+            fmi2SerializeFMUstate(f.c, state, buffer.as_mut_ptr(), size - 1),
+            3
+        );
+        assert_eq!(fmi2SetFMUstate(f.c, back), 0);
+        fmi2FreeFMUstate(f.c, &mut back);
+        fmi2FreeFMUstate(f.c, &mut state);
+    }
+}

@@ -11,6 +11,8 @@ use wheelflat::fmu::vars::FmuTable;
 /// One logged message.
 #[derive(Debug, Clone)]
 pub struct Record {
+    /// The instance name the logger was given.
+    pub instance: String,
     pub status: c_int,
     pub category: String,
     pub message: String,
@@ -56,7 +58,7 @@ impl Log {
 /// `fmi2CallbackLogger` type (same calling convention for the fixed arguments).
 unsafe extern "C" fn record(
     env: fmi2ComponentEnvironment,
-    _name: fmi2String,
+    name: fmi2String,
     status: fmi2Status,
     category: fmi2String,
     message: fmi2String,
@@ -70,6 +72,7 @@ unsafe extern "C" fn record(
     };
     let log = unsafe { &*(env as *const Log) };
     let r = Record {
+        instance: text(name),
         status,
         category: text(category),
         message: text(message).replace("%%", "%"),

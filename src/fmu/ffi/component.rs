@@ -230,6 +230,19 @@ pub(super) fn c_str(s: fmi2String) -> Option<String> {
     }
 }
 
+/// The instance name as given: UTF-8 as it is, other bytes escaped (`\xff`) so that a
+/// log shows the name the master gave; `None` for a null pointer.
+pub(super) fn instance_name(s: fmi2String) -> Option<String> {
+    if s.is_null() {
+        return None;
+    }
+    let bytes = unsafe { CStr::from_ptr(s) }.to_bytes();
+    Some(match std::str::from_utf8(bytes) {
+        Ok(text) => text.to_string(),
+        Err(_) => bytes.escape_ascii().to_string(),
+    })
+}
+
 /// An `fmi2Boolean` argument: fmi2True (1) or fmi2False (0), nothing else.
 pub(super) fn boolean(
     inst: &mut Instance,

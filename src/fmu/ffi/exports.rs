@@ -78,7 +78,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
             let f = unsafe { &*functions };
             f.logger.map(|l| (l, f.componentEnvironment))
         };
-        let name = c_str(instanceName).unwrap_or_default();
+        let name = instance_name(instanceName).unwrap_or_default();
         let clog = cb.map(|(l, env)| CLogger {
             logger: l,
             env,
@@ -93,8 +93,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
         if functions.is_null() {
             return std::ptr::null_mut();
         }
-        if name.is_empty() {
-            return fail("fmi2Instantiate: instanceName is null or empty".into());
+        if name.trim().is_empty() {
+            return fail(format!(
+                "fmi2Instantiate: instanceName {}; FMI 2.0 requires a non-empty name",
+                if instanceName.is_null() {
+                    "is null".to_string()
+                } else {
+                    format!("= {name:?}")
+                }
+            ));
         }
         for (what, v) in [("visible", visible), ("loggingOn", loggingOn)] {
             if v != 0 && v != 1 {
@@ -458,16 +465,20 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
         let out = slice_mut(&mut x.inst, call, "serializedState", serializedState, size)?;
         let Inner { inst, states } = x;
         let b = inst.serialize(&states[&key])?;
-        if b.len() != size {
+        if b.len() > size {
             return inst.refuse(
                 Status::Error,
                 format!(
-                    "fmi2SerializeFMUstate: size = {size} bytes; allowed: {} (from fmi2SerializedFMUstateSize)",
+                    "fmi2SerializeFMUstate: size = {size} bytes; allowed: at least {} (from \
+                     fmi2SerializedFMUstateSize)",
                     b.len()
                 ),
             );
         }
-        for (o, x) in out.iter_mut().zip(b) {
+        // A larger buffer is legal: the state, then zeros (which fmi2DeSerializeFMUstate
+        // takes as padding).
+        let padded = b.into_iter().chain(std::iter::repeat(0));
+        for (o, x) in out.iter_mut().zip(padded) {
             *o = x as fmi2Byte;
         }
         Ok(())

@@ -207,8 +207,14 @@ impl<M: Model> Instance<M> {
         for _ in 0..nm {
             state.push(r.f64()?);
         }
-        if r.at != bytes.len() {
-            return Err(format!("{} trailing bytes", bytes.len() - r.at));
+        // A buffer larger than the state (legal in fmi2SerializeFMUstate) is padded with
+        // zeros there; anything else after the state is damage.
+        if bytes[r.at..].iter().any(|&b| b != 0) {
+            return Err(format!(
+                "{} trailing bytes after the state that are not the zero padding of a larger \
+                 buffer",
+                bytes.len() - r.at
+            ));
         }
         // A stopped run's model state is beyond the health bounds by definition, and
         // nothing can be read from it or stepped: it is restored as the stopped run
