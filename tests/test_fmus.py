@@ -751,7 +751,13 @@ def test_wheelsets_beyond_the_count_read_zero_and_take_inputs_unused(paths):
     u = initialised(paths, "TrackContact", params={"wheelsets": 2, "track.window.ahead": 20.0})
     assert u.get("wheelset[2].contact.left.force")[0] == pytest.approx(107664.75, rel=1e-9)
     assert u.get("contact.left.force")[0] == pytest.approx(107664.75, rel=1e-9)
-    assert u.get("wheelset[2].wheel.left.z") == u.get("wheelset[2].static_wheel_z.left")
+    # Read back, an input never set is its start value (issue 25), which stands for the
+    # static height under inputs.datum = first_step; the static height is published.
+    from fmpy import read_model_description
+    start = {v.name: float(v.start) for v in read_model_description(paths["TrackContact"]).modelVariables
+             if v.start is not None and v.type == "Real"}
+    assert u.get("wheelset[2].wheel.left.z") == [start["wheelset[2].wheel.left.z"]]
+    assert u.get("wheelset[2].static_wheel_z.left")[0] == pytest.approx(-1.6428e-3, abs=1e-7)
     assert u.get("wheelset[2].position")[0] == pytest.approx(1.37 - 1.8, abs=1e-12)
     assert u.get("wheelset[3].contact.left.force", "wheelset[3].position") == [0.0, 0.0]
     u.set(["wheelset[3].wheel.left.z"], [-0.002])

@@ -429,11 +429,12 @@ impl VehicleUnit {
     }
 
     /// Sets the contact forces `[left, right]` (N) of wheelset `k` (with the axle-box
-    /// interface the primary forces), held over the next communication step.
+    /// interface the primary forces), held over the next communication step. Forces no
+    /// physical run reaches are refused by the step that would use them
+    /// ([`VehicleUnit::advance`]).
     ///
-    /// Errors: a wheelset the vehicle does not have; a force not finite, or beyond
-    /// [`crate::limits::force_limit`] of the static loads (20 times the larger, at
-    /// least 2 MN), which no physical run reaches; nothing is set then.
+    /// Errors: a wheelset the vehicle does not have; a force not finite; nothing is set
+    /// then.
     pub fn set_forces_of(&mut self, k: usize, p: [f64; 2]) -> Result<()> {
         if k >= self.wheelsets() {
             return Err(out_of_range(
@@ -442,7 +443,15 @@ impl VehicleUnit {
                 format!("1 to {}", self.wheelsets()),
             ));
         }
-        let lim = crate::limits::force_limit(self.static_load());
+        for (side, x) in [("left", p[0]), ("right", p[1])] {
+            finite(&self.force_name(k, side), x, "N")?;
+        }
+        self.force[k] = p;
+        Ok(())
+    }
+
+    /// The FMU name of wheelset `k`'s held force on `side`.
+    fn force_name(&self, k: usize, side: &str) -> String {
         let kind = if self.is_axle_box() {
             "axle_box"
         } else {
@@ -453,23 +462,32 @@ impl VehicleUnit {
         } else {
             format!("wheelset[{}].", k + 1)
         };
-        for (side, x) in [("left", p[0]), ("right", p[1])] {
-            let name = format!("{prefix}{kind}.{side}.force");
-            finite(&name, x, "N")?;
-            if !crate::limits::within(x, lim) {
-                return Err(crate::error::out_of_range(
-                    &name,
-                    x,
-                    format!(
-                        "|{name}| <= {} N ({} times the static wheel load), which no physical \
-                         run exceeds",
-                        crate::error::num(lim),
-                        crate::limits::FORCE_LIMIT_FACTOR
-                    ),
-                ));
+        format!("{prefix}{kind}.{side}.force")
+    }
+
+    /// Refuses held forces beyond [`crate::limits::force_limit`] of the static loads (20
+    /// times the larger, at least 2 MN), which no physical run reaches.
+    fn check_held_forces(&self) -> Result<()> {
+        let lim = crate::limits::force_limit(self.static_load());
+        for k in 0..self.wheelsets() {
+            for (s, side) in ["left", "right"].into_iter().enumerate() {
+                let x = self.force[k][s];
+                if !within(x, lim) {
+                    let name = self.force_name(k, side);
+                    return Err(out_of_range(
+                        &name,
+                        x,
+                        format!(
+                            "|{name}| <= {} N ({} times the static wheel load), which no \
+                             physical run exceeds; the step was not taken: likely the partner \
+                             diverged",
+                            num(lim),
+                            crate::limits::FORCE_LIMIT_FACTOR
+                        ),
+                    ));
+                }
             }
         }
-        self.force[k] = p;
         Ok(())
     }
 
@@ -497,6 +515,7 @@ impl VehicleUnit {
     /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`Error::Diverged`]).
     pub fn advance(&mut self, h: f64, tolerance: f64) -> Result<()> {
         positive("communication step", h, "s")?;
+        self.check_held_forces()?;
         let s = self.clock.substeps(h, tolerance);
         if s.n == 0.0 {
             self.clock.carried = s.total;

@@ -60,6 +60,11 @@ impl InputDatum {
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
     }
 
+    /// Whether the inputs are measured from the first step's (`first_step`).
+    pub(super) fn is_relative(&self) -> bool {
+        self.relative
+    }
+
     /// Whether wheelset `k`'s inputs stand for the static state whatever they are (not
     /// fixed yet, with `first_step`).
     pub(super) fn follows(&self, k: usize) -> bool {

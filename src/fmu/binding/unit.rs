@@ -411,7 +411,10 @@ impl Model for FmuModel {
             return None;
         }
         let sim = self.simulation()?;
-        if self.kind != Kind::TrackContact {
+        // With inputs.datum = first_step an input never set keeps its start value,
+        // which stands for the static state like any first input; with absolute the
+        // input reports where the track rests.
+        if self.kind != Kind::TrackContact || self.datum.is_relative() {
             return None;
         }
         // The axle-box interface's side frames at rest.

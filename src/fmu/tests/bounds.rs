@@ -422,36 +422,37 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
 }
 
 #[test]
-fn vehicle_forces_no_physical_run_reaches_are_refused_at_set_and_change_nothing() {
+fn vehicle_forces_no_physical_run_reaches_are_refused_by_the_step_that_would_use_them() {
+    // Issue 25: the set takes what the model description declares (|F| <= 1e7 N); the
+    // physical bound depends on the parameters (20 times the static wheel load, at least
+    // 2 MN), so the step refuses it, naming the force, and nothing moves.
     let (mut v, _) = instance(Kind::RollPlaneVehicle);
     v.enter_initialization().unwrap();
     v.exit_initialization().unwrap();
     let w = v.value(vr::CONTACT_LEFT_FORCE);
-    // 20 times the static wheel load of table 4.4 (107.66 kN), at least 2 MN.
     let limit = crate::limits::force_limit([w, w]);
     assert_eq!(limit, 20.0 * w);
-    let e = v
-        .set_real(
-            &[vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
-            &[w, 1.01 * limit],
-        )
-        .unwrap_err();
+    v.set_real(
+        &[vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
+        &[w, 1.01 * limit],
+    )
+    .unwrap();
+    let z0 = real(&mut v, vr::WHEEL_RIGHT_Z);
+    let e = v.do_step(0.0, 1e-3).unwrap_err();
     assert_eq!(e.status, Status::Error);
     assert!(
         e.message.contains("contact.right.force") && e.message.contains("2153295 N"),
         "{}",
         e.message
     );
-    // Neither force was taken: the run goes on at the static loads, which hold the
-    // vehicle where it is.
-    assert_eq!(v.value(vr::CONTACT_RIGHT_FORCE), w);
-    let z0 = real(&mut v, vr::WHEEL_RIGHT_Z);
-    v.do_step(0.0, 1e-3).unwrap();
-    assert!((real(&mut v, vr::WHEEL_RIGHT_Z) - z0).abs() < 1e-9);
-    assert_eq!(real(&mut v, vr::CONTACT_RIGHT_MAX_FORCE), w);
-    // Just inside the bound is taken.
+    assert_eq!(v.time(), 0.0);
+    assert!((real(&mut v, vr::WHEEL_RIGHT_Z) - z0).abs() < 1e-12);
+    // Beyond the declared range: refused at the set.
+    assert!(v.set_real(&[vr::CONTACT_RIGHT_FORCE], &[1.1e7]).is_err());
+    // Just inside the bound is taken, and the run goes on (its first step warned of:
+    // the forces do not hold the vehicle at rest).
     v.set_real(&[vr::CONTACT_RIGHT_FORCE], &[0.99 * limit])
         .unwrap();
-    v.do_step(1e-3, 1e-3).unwrap();
+    stepped(v.do_step(0.0, 1e-3), true);
     assert_eq!(real(&mut v, vr::CONTACT_RIGHT_MAX_FORCE), 0.99 * limit);
 }
