@@ -77,12 +77,8 @@ impl Simulation {
         }
         let now = self.time();
         if let VehicleState::External { wheel_z, rates, .. } = self.external(k)? {
-            if rates.moves() {
-                for side in 0..2 {
-                    Self::give_height(wheel_z, rates, side, z[side], now);
-                }
-            } else {
-                *wheel_z = z;
+            for side in 0..2 {
+                Self::give_height(wheel_z, rates, side, z[side], now);
             }
         }
         self.clear_cache();
@@ -138,7 +134,10 @@ impl Simulation {
     }
 
     /// One wheel's height `z` (m) given at `now` (s): its derivatives given at an
-    /// earlier time are dropped (the height is held), those given now stay.
+    /// earlier time are dropped (the height is held), those given now stay, and the
+    /// height's polynomial is anchored now whatever came first at this point, the height
+    /// or its derivatives (the standard fixes no order; derivatives first given late
+    /// were anchored at the last time derivatives were dropped, 0 at first).
     fn give_height(
         wheel_z: &mut [f64; 2],
         rates: &mut super::simulation::InputRates,
@@ -147,12 +146,12 @@ impl Simulation {
         now: f64,
     ) {
         wheel_z[side] = z;
-        // Without derivatives the time a height was given does not matter (derivatives
-        // given later at the same time extrapolate from the height then, which is it).
-        if rates.z_given[side] && rates.z_since[side] != now {
-            rates.z[0][side] = 0.0;
-            rates.z[1][side] = 0.0;
-            rates.z_given[side] = false;
+        if rates.z_since[side] != now {
+            if rates.z_given[side] {
+                rates.z[0][side] = 0.0;
+                rates.z[1][side] = 0.0;
+                rates.z_given[side] = false;
+            }
             rates.z_since[side] = now;
         }
     }
