@@ -1308,3 +1308,37 @@ def test_every_fmu_instantiates_with_the_libraries_loaded_rtld_global(paths):
     assert len(lines) == 4, r.stdout
     for line in lines:
         assert line.endswith("statuses [0, 0, 0, 0]"), r.stdout
+
+
+@pytest.mark.parametrize("name", ["RollPlaneVehicle", "HalfCarBogie"])
+def test_every_real_output_of_the_vehicles_has_its_first_derivative(paths, name):
+    # Issue 25: maxOutputDerivativeOrder = 1 is declared without restriction, so every
+    # Real output answers: the rate over the next substep under the held inputs, which a
+    # step of one substep then shows; the extremes are piecewise constant (0).
+    from fmpy import read_model_description
+    md = read_model_description(paths[name])
+    outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    u = initialised(paths, name)
+    dt = u.get("solver.step")[0]
+    forces = [v.name for v in md.modelVariables if v.causality == "input" and v.name.endswith("contact.left.force")]
+    u.set(forces, [1.3e5] * len(forces))
+    t = 0.0
+    for _ in range(20):
+        u.fmu.doStep(t, dt)
+        t += dt
+    vrs = [v.valueReference for v in outputs]
+    rates = u.fmu.getRealOutputDerivatives(vrs, [1] * len(vrs))
+    before = u.fmu.getReal(vrs)
+    u.fmu.doStep(t, dt)
+    after = u.fmu.getReal(vrs)
+    moving = 0
+    for v, r, a, b in zip(outputs, rates, before, after):
+        if v.name.endswith("max_force") or v.name.endswith("min_force"):
+            assert r == 0.0, v.name
+            continue
+        if v.name in ("wheel.left.z", "wheel.right.z") or ".wheel." in v.name or "sideframe" in v.name and v.name.endswith(".z"):
+            continue  # backward differences over the last substep (documented)
+        assert r == pytest.approx((b - a) / dt, rel=1e-9, abs=1e-9), v.name
+        moving += abs(r) > 1e-9
+    assert moving >= 4, moving
+    u.close()

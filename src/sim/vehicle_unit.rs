@@ -213,6 +213,10 @@ impl VehicleUnit {
     pub fn dt_base(&self) -> f64 {
         self.clock.base
     }
+    /// The substep in use (s).
+    pub fn dt(&self) -> f64 {
+        self.clock.dt
+    }
     /// Critical step of the vehicle's explicit scheme (s).
     pub fn critical_step(&self) -> f64 {
         match &self.params.half_car {

@@ -792,7 +792,25 @@ impl Model for FmuModel {
                     .ok_or_else(|| no_derivative(r));
             }
         }
-        Err(no_derivative(r))
+        // The extremes are piecewise constant: 0 between their jumps.
+        use crate::fmu::vars::Quantity;
+        if let Some(Some((Quantity::ContactMaxForce | Quantity::ContactMinForce, _, _))) =
+            crate::fmu::vars::QUANTITIES.get(r as usize)
+        {
+            return Ok(0.0);
+        }
+        // Every other output: its rate over one more substep under the held inputs, a
+        // forward difference (first order in the substep; the held forces' is 0).
+        let dt = u.dt();
+        let mut ahead = self.clone();
+        if let Engine::Vehicle(t) = &mut ahead.engine {
+            t.advance(dt, 0.0)?;
+        }
+        let (now, next) = (
+            self.output(&self.outputs(), r),
+            ahead.output(&ahead.outputs(), r),
+        );
+        Ok((next - now) / dt)
     }
 
     /// TrackContact (contact interface): the contact forces and overlaps of each
