@@ -1342,3 +1342,53 @@ def test_every_real_output_of_the_vehicles_has_its_first_derivative(paths, name)
         moving += abs(r) > 1e-9
     assert moving >= 4, moving
     u.close()
+
+
+def test_every_declared_directional_derivative_is_answered_and_the_rest_is_zero(paths):
+    # Issue 25: 80 declared pairs (front/rear angle, length, extremes) were refused and
+    # undeclared pairs refused instead of 0. Against a central difference of the
+    # feedthrough, at rest and as the flat passes the contact (partial contact).
+    from fmpy import read_model_description
+    md = read_model_description(paths["TrackContact"])
+    index = {i + 1: v for i, v in enumerate(md.modelVariables)}
+    declared = {}
+    for u in md.outputs:
+        declared[u.variable.name] = {d.name for d in (u.dependencies or [])}
+    t = initialised(paths, "TrackContact")
+    h = t.get("solver.step")[0]
+    knowns = ["wheel.left.z", "wheel.right.z", "wheel.rotation"]
+    reals = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    answered = 0
+    for k in range(2161):
+        if k in (1, 2160):
+            z0 = t.get(*knowns)
+            for known, e in zip(knowns, (1e-9, 1e-9, 1e-7)):
+                i = knowns.index(known)
+                t.set([known], [z0[i] + e])
+                up = t.get(*reals)
+                t.set([known], [z0[i] - e])
+                down = t.get(*reals)
+                t.set([known], [z0[i]])
+                exact = t.fmu.getDirectionalDerivative([t.vr[n] for n in reals], [t.vr[known]], [1.0])
+                for name, d, a, b in zip(reals, exact, up, down):
+                    fd = (a - b) / (2 * e)
+                    if known in declared.get(name, set()):
+                        assert d == pytest.approx(fd, rel=1e-3, abs=1e-3 * max(1.0, abs(fd))), (k, name, known, d, fd)
+                        answered += 1
+                    else:
+                        assert d == 0.0 and abs(fd) < 1e-6 * max(1.0, abs(a)), (k, name, known, d, fd)
+        t.fmu.doStep(k * h, h)
+    # The declared pairs of wheelset 1 at each of the two points: per wheel force, front
+    # and rear angle, length, max and min against its height and the rotation, the
+    # overlap against its height (13).
+    assert answered == 2 * 2 * 13, answered
+    t.close()
+    # At the axle boxes the primary forces follow their side frame at once: -K_1, -C_1.
+    t = initialised(paths, "TrackContact", params={"interface": 2})
+    frames = ["sideframe.left.z", "sideframe.right.z"]
+    t.set(frames, t.get(*frames))      # given, so they follow from the first step on
+    t.fmu.doStep(0.0, 1e-3)
+    f = [t.vr[n] for n in ("primary.left.force", "primary.left.mean_force", "primary.right.force")]
+    for known, expected in (("sideframe.left.z", -6.5e6), ("sideframe.left.v", -1e5)):
+        assert t.fmu.getDirectionalDerivative(f, [t.vr[known]], [1.0]) == [expected, expected, 0.0]
+    t.close()

@@ -318,6 +318,11 @@ impl PrimaryLink {
         self.stiffness
     }
 
+    /// The primary damping `C_1` (N s/m).
+    pub fn damping(&self) -> f64 {
+        self.damping
+    }
+
     /// The side frames' inertia.
     pub fn inertia(&self) -> SideFrameInertia {
         self.inertia

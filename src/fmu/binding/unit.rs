@@ -142,18 +142,44 @@ fn wheel_input(r: u32) -> Option<(usize, usize)> {
         .find_map(|(k, refs)| refs.iter().position(|&x| x == r).map(|i| (k, i)))
 }
 
-/// The wheelset, side and whether it is the force (else the overlap) of a contact
-/// output `r` of TrackContact.
-fn contact_output(r: u32) -> Option<(usize, usize, bool)> {
+/// The wheelset, side and quantity of a contact output `r` of TrackContact.
+fn contact_output(r: u32) -> Option<(usize, usize, crate::fmu::vars::Quantity)> {
     use crate::fmu::vars::Quantity;
     let &Some((q, side, k)) = crate::fmu::vars::QUANTITIES.get(r as usize)? else {
         return None;
     };
     match q {
-        Quantity::ContactForce => Some((k, side, true)),
-        Quantity::ContactOverlap => Some((k, side, false)),
+        Quantity::ContactForce
+        | Quantity::ContactOverlap
+        | Quantity::ContactFrontAngle
+        | Quantity::ContactRearAngle
+        | Quantity::ContactLength
+        | Quantity::ContactMaxForce
+        | Quantity::ContactMinForce => Some((k, side, q)),
         _ => None,
     }
+}
+
+/// The wheelset and side of a primary-force output `r` of TrackContact (at the point or
+/// the mean, `interface = axle_box`).
+fn primary_output(r: u32) -> Option<(usize, usize)> {
+    use crate::fmu::vars::Quantity;
+    let &Some((q, side, k)) = crate::fmu::vars::QUANTITIES.get(r as usize)? else {
+        return None;
+    };
+    matches!(q, Quantity::PrimaryForce | Quantity::PrimaryMeanForce).then_some((k, side))
+}
+
+/// The wheelset, side and whether it is the velocity of a side-frame input `r`.
+fn frame_input(r: u32) -> Option<(usize, usize, bool)> {
+    std::iter::once(FRAME_VRS)
+        .chain(TRAILING_FRAME_VRS)
+        .enumerate()
+        .find_map(|(k, refs)| {
+            refs.iter()
+                .position(|&x| x == r)
+                .map(|i| (k, i % 2, i >= 2))
+        })
 }
 
 /// The engine behind an FMU.
@@ -813,32 +839,50 @@ impl Model for FmuModel {
         Ok((next - now) / dt)
     }
 
-    /// TrackContact (contact interface): the contact forces and overlaps of each
-    /// wheelset with respect to its wheel heights, exactly (the contact stiffness
-    /// [`crate::contact::ContactLaw::stiffness_at`]: `dP/dz = -dP/d delta`; `d
-    /// delta/dz = -1`), and the forces with respect to the axle angle (a central
-    /// difference of the law, step 1e-7 rad: a flat turning into the patch); 0
-    /// across wheels and wheelsets.
+    /// TrackContact, every pair its model description declares. Contact interface:
+    /// the contact forces and overlaps of each wheelset with respect to its wheel
+    /// heights exactly (the contact stiffness
+    /// [`crate::contact::ContactLaw::stiffness_at`]: `dP/dz = -dP/d delta`; `d delta/dz
+    /// = -1`); the forces with respect to the axle angle, and the patch's front and rear
+    /// angles and length with respect to either input, by central differences of the
+    /// law (1e-9 m, 1e-7 rad); the extremes follow the force where it is the extreme
+    /// now, else 0. Axle boxes: the primary forces with respect to their side frame's
+    /// displacement and velocity exactly (`-K_1`, `-C_1`). Every pair the model
+    /// description does not declare is 0; before the first step, the displacement
+    /// inputs stand for the static state (`inputs.datum = first_step`): 0.
     fn partial_derivative(&self, unknown: u32, known: u32) -> Result<f64, Error> {
-        let not = || {
-            Error::Unsupported(format!(
-                "the derivative of `{}` with respect to `{}`: TrackContact gives those of \
-                 contact.*.force and contact.*.overlap (and wheelset[k]'s) with respect to \
-                 wheel.*.z and wheel.rotation, with the contact interface",
+        use crate::fmu::vars::Quantity;
+        let Engine::Sim(sim) = &self.engine else {
+            return Err(Error::Unsupported(format!(
+                "the derivative of `{}` with respect to `{}`: only TrackContact gives \
+                 directional derivatives",
                 name_of(unknown),
                 name_of(known)
-            ))
+            )));
         };
-        let Engine::Sim(sim) = &self.engine else {
-            return Err(not());
-        };
-        if self.kind != Kind::TrackContact || matches!(sim.vehicle(), VehicleState::AxleBox(_)) {
-            return Err(not());
+        if let VehicleState::AxleBox(_) = sim.vehicle() {
+            let (Some((ku, su)), Some((kk, sk, velocity))) =
+                (primary_output(unknown), frame_input(known))
+            else {
+                return Ok(0.0);
+            };
+            let Some(VehicleState::AxleBox(link)) = sim.wheelsets().get(ku).map(|w| w.vehicle())
+            else {
+                return Ok(0.0);
+            };
+            if ku != kk || su != sk || (!velocity && self.datum.follows(ku)) {
+                return Ok(0.0);
+            }
+            return Ok(if velocity {
+                -link.damping()
+            } else {
+                -link.stiffness()
+            });
         }
-        let (Some((ku, side, force)), Some((kk, which))) =
+        let (Some((ku, side, q)), Some((kk, which))) =
             (contact_output(unknown), wheel_input(known))
         else {
-            return Err(not());
+            return Ok(0.0);
         };
         let Some(sample) = sim.sample_of(ku) else {
             return Ok(0.0);
@@ -847,28 +891,55 @@ impl Model for FmuModel {
             return Ok(0.0);
         }
         // Before the first step the wheel heights stand for the static state
-        // (`inputs.datum = first_step`): the forces do not follow them yet.
+        // (`inputs.datum = first_step`): the outputs do not follow them yet.
         if which != 2 && self.datum.follows(ku) {
             return Ok(0.0);
         }
-        let wheel = &sim
-            .wheelsets()
-            .get(ku)
-            .expect("the sample's wheelset")
-            .wheels()[side];
+        let w = sim.wheelsets().get(ku).expect("the sample's wheelset");
+        let wheel = &w.wheels()[side];
         let law = sim.contact_law();
         let overlap = sample.contact[side].overlap;
         let gamma = sample.rotation;
-        Ok(match (which, force) {
-            (2, false) => 0.0,
-            (2, true) => {
+        // A central difference of the law's state in the overlap (a height raises it by
+        // as much as it lowers the wheel) or the axle angle.
+        let difference = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
+            if which == 2 {
                 let e = 1e-7;
-                (law.evaluate(wheel, gamma + e, overlap).force
-                    - law.evaluate(wheel, gamma - e, overlap).force)
+                (pick(&law.evaluate(wheel, gamma + e, overlap))
+                    - pick(&law.evaluate(wheel, gamma - e, overlap)))
+                    / (2.0 * e)
+            } else {
+                let e = 1e-9;
+                -(pick(&law.evaluate(wheel, gamma, overlap + e))
+                    - pick(&law.evaluate(wheel, gamma, overlap - e)))
                     / (2.0 * e)
             }
-            (_, true) => -law.stiffness_at(wheel, gamma, overlap),
-            (_, false) => -1.0,
+        };
+        let force = || {
+            if which == 2 {
+                difference(&|c| c.force)
+            } else {
+                -law.stiffness_at(wheel, gamma, overlap)
+            }
+        };
+        let p = sample.contact[side].force;
+        Ok(match q {
+            Quantity::ContactForce => force(),
+            Quantity::ContactOverlap => {
+                if which == 2 {
+                    0.0
+                } else {
+                    -1.0
+                }
+            }
+            Quantity::ContactFrontAngle => difference(&|c| c.front_angle),
+            Quantity::ContactRearAngle => difference(&|c| c.rear_angle),
+            Quantity::ContactLength => difference(&|c| c.length),
+            // The extreme is the force now where the force is beyond the extremes of the
+            // steps taken.
+            Quantity::ContactMaxForce if p >= w.max_force()[side] => force(),
+            Quantity::ContactMinForce if p <= w.min_force()[side] => force(),
+            _ => 0.0,
         })
     }
 
