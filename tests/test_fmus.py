@@ -1392,3 +1392,19 @@ def test_every_declared_directional_derivative_is_answered_and_the_rest_is_zero(
     for known, expected in (("sideframe.left.z", -6.5e6), ("sideframe.left.v", -1e5)):
         assert t.fmu.getDirectionalDerivative(f, [t.vr[known]], [1.0]) == [expected, expected, 0.0]
     t.close()
+
+
+@pytest.mark.parametrize("ratio, within", [(0.5, 0.005), (10e-6 / 14.413057013760613e-6, 0.005), (0.9, 0.005), (1.5, 0.015)])
+def test_a_masters_round_step_is_honoured_by_the_automatic_track_step(paths, ratio, within):
+    # Issue 25: with solver.dt = 0 TrackContact fits its step to the master's first
+    # communication step (the nearest whole number of steps in it), so the track's grid
+    # meets the master's points: +4.74 %, +3.42 %, +4.52 %, +5.51 % before at these
+    # ratios (the pair, sequential, peak against 306.42 kN at the track's own step).
+    dt = 14.413057013760613e-6
+    out = wf.run_pair(paths, 0.1, comm_step=ratio * dt)
+    peak = max(out["contact.left.max_force"])
+    assert abs(peak / 306.42e3 - 1) < within, peak
+    t = initialised(paths, "TrackContact")
+    t.fmu.doStep(0.0, 1e-5)
+    assert t.get("solver.step")[0] == 1e-5
+    t.close()
