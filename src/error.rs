@@ -56,6 +56,15 @@ pub enum Error {
     },
     /// A request this model does not support.
     Unsupported(String),
+    /// An input value the step that would use it refuses (nothing moves).
+    Input {
+        /// The input's name.
+        name: String,
+        /// Its value.
+        value: f64,
+        /// The allowed values, in words.
+        allowed: String,
+    },
 }
 
 /// A number for a message: plain where that is short, in exponent form otherwise.
@@ -114,6 +123,15 @@ impl fmt::Display for Error {
                 num(*limit)
             ),
             Error::Unsupported(what) => write!(f, "not supported: {what}"),
+            Error::Input {
+                name,
+                value,
+                allowed,
+            } => write!(
+                f,
+                "input `{name}` = {} is out of range: allowed {allowed}",
+                num(*value)
+            ),
         }
     }
 }

@@ -1407,4 +1407,10 @@ def test_a_masters_round_step_is_honoured_by_the_automatic_track_step(paths, rat
     t = initialised(paths, "TrackContact")
     t.fmu.doStep(0.0, 1e-5)
     assert t.get("solver.step")[0] == 1e-5
+    # A serialized state carries the fitted step into another instance, which says so.
+    data = t.fmu.serializeFMUstate(t.fmu.getFMUstate())
+    other = initialised(paths, "TrackContact")
+    other.fmu.setFMUstate(other.fmu.deSerializeFMUstate(data))
+    assert other.get("solver.step")[0] == 1e-5
+    other.close()
     t.close()

@@ -478,17 +478,19 @@ impl VehicleUnit {
                 let x = self.force[k][s];
                 if !within(x, lim) {
                     let name = self.force_name(k, side);
-                    return Err(out_of_range(
-                        &name,
-                        x,
-                        format!(
-                            "|{name}| <= {} N ({} times the static wheel load), which no \
-                             physical run exceeds; the step was not taken: likely the partner \
-                             diverged",
+                    return Err(Error::Input {
+                        value: x,
+                        allowed: format!(
+                            "|{name}| <= {} N ({} times the static wheel load, at least {} N), \
+                             which no physical run exceeds; the step was not taken: likely the \
+                             partner diverged",
                             num(lim),
-                            crate::limits::FORCE_LIMIT_FACTOR
+                            crate::limits::FORCE_LIMIT_FACTOR,
+                            num(crate::limits::FORCE_LIMIT_FACTOR
+                                * crate::limits::FORCE_LIMIT_MIN_STATIC_LOAD)
                         ),
-                    ));
+                        name,
+                    });
                 }
             }
         }

@@ -781,6 +781,8 @@ impl Model for FmuModel {
         self.watch.restart();
         if let Engine::Sim(sim) = &self.engine {
             self.master_end = sim.time();
+            // The step in use, fitted to a master's first step or not.
+            self.published.step = sim.dt();
         }
         Ok(())
     }
