@@ -11,12 +11,14 @@ RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 cargo build --release
 cargo test --release
 
+echo "   (${SECONDS} s so far)"
 echo "== FMUs: pack fmu/*.fmu and the C header, the library against the glibc 2.28 baseline"
 "${CARGO_TARGET_DIR:-target}/release/build_fmus" fmu
 # The FMUs the tests below load are the ones users get: built with cargo-zigbuild
 # against glibc 2.28 (objdump -T checked), which sets up .venv first.
 bash scripts/build_fmus_glibc228.sh fmu
 
+echo "   (${SECONDS} s so far)"
 echo "== Python: .venv with fmpy, libcosimpy and ecospy, then the FMU tests"
 # ecospy's library needs oneTBB (Debian's libtbb12); CI runs as root with Debian's registries.
 if ! ldconfig -p | grep libtbb.so.12 >/dev/null; then
@@ -28,9 +30,11 @@ python3 python/wheelflat_fmus.py
 # test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem
 .venv/bin/python -m pytest -q tests/test_fmus.py tests/test_study.py tests/test_masters.py
 
+echo "   (${SECONDS} s so far)"
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
 # bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
 # the C compiler's own headers.
 LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)" \
 BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)" \
     cargo test --manifest-path tests/fmi_import/Cargo.toml
+echo "== done in ${SECONDS} s"

@@ -1265,14 +1265,15 @@ def test_each_fmu_carries_its_icon(paths, name):
 # ------------------------------------------------------------------ issue 25
 
 RTLD_GLOBAL_SCRIPT = r'''
-import ctypes, os, sys, tempfile, zipfile
+import ctypes, math, os, random, sys, tempfile, zipfile
 from fmpy import read_model_description
 from fmpy.fmi2 import (fmi2CallbackFunctions, fmi2CallbackLoggerTYPE,
                        fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE)
-paths = dict(arg.split("=", 1) for arg in sys.argv[1:])
+seed = int(sys.argv[1])
+paths = dict(arg.split("=", 1) for arg in sys.argv[2:])
 msgs = []
 cb = fmi2CallbackFunctions()
-cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: msgs.append(m.decode()))
+cb.logger = fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: msgs.append((s, m.decode(errors="replace"))))
 cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(lambda n, s: None)
 cb.freeMemory = fmi2CallbackFreeMemoryTYPE(lambda p: None)
 libs = []
@@ -1281,33 +1282,91 @@ for name, path in paths.items():
     with zipfile.ZipFile(path) as z:
         z.extractall(d)
     lib = ctypes.CDLL(os.path.join(d, "binaries", "linux64", name + ".so"), mode=ctypes.RTLD_GLOBAL)
-    libs.append((name, lib, read_model_description(path).guid, d))
-for name, lib, guid, d in libs:
     lib.fmi2Instantiate.restype = ctypes.c_void_p
-    c = lib.fmi2Instantiate(b"x", 1, guid.encode(), ("file://" + d + "/resources").encode(),
+    libs.append((name, lib, read_model_description(path), d))
+D, U, I = ctypes.c_double, ctypes.c_uint, ctypes.c_int
+rng = random.Random(seed)
+bad = []
+units = []
+for name, lib, md, d in libs:
+    c = lib.fmi2Instantiate(b"x", 1, md.guid.encode(), ("file://" + d + "/resources").encode(),
                             ctypes.byref(cb), 0, 0)
     if not c:
         print(name, "refused:", msgs[-1:])
         continue
     c = ctypes.c_void_p(c)
-    steps = [lib.fmi2SetupExperiment(c, 0, ctypes.c_double(0.0), ctypes.c_double(0.0), 0),
-             lib.fmi2EnterInitializationMode(c), lib.fmi2ExitInitializationMode(c),
-             lib.fmi2DoStep(c, ctypes.c_double(0.0), ctypes.c_double(1e-3), 1)]
+    init = [lib.fmi2SetupExperiment(c, 0, D(0.0), D(0.0), 0),
+            lib.fmi2EnterInitializationMode(c), lib.fmi2ExitInitializationMode(c),
+            lib.fmi2DoStep(c, D(0.0), D(1e-4), 1)]
+    print(name, "statuses", init)
+    inputs = [v for v in md.modelVariables if v.causality == "input" and v.type == "Real"]
+    outputs = [v for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+    units.append([name, lib, md, c, inputs, outputs, 1e-4])
+# Random calls, the derivative functions late and in any order among them, on all four
+# libraries interleaved: statuses are FMI statuses, every non-OK one is logged, and no
+# output read with fmi2OK is NaN or infinite.
+for n in range(400):
+    u = rng.choice(units)
+    name, lib, md, c, inputs, outputs, t = u
+    call = rng.choice(["set", "get", "step", "inder", "outder", "dirder"])
+    before = len(msgs)
+    if call == "set" and inputs:
+        v = rng.choice(inputs)
+        x = float(v.start) * (1 + rng.uniform(-1e-3, 1e-3)) if v.start else rng.uniform(-1e-3, 1e-3)
+        s = lib.fmi2SetReal(c, (U * 1)(v.valueReference), 1, (D * 1)(x))
+    elif call == "get":
+        vrs = rng.sample(outputs, min(8, len(outputs)))
+        out = (D * len(vrs))()
+        s = lib.fmi2GetReal(c, (U * len(vrs))(*[v.valueReference for v in vrs]), len(vrs), out)
+        if s == 0 and not all(math.isfinite(x) for x in out):
+            bad.append((name, n, "non-finite output with fmi2OK"))
+    elif call == "step":
+        h = rng.choice([1e-5, 1.4413057013760613e-5, 1e-4, 1e-3])
+        s = lib.fmi2DoStep(c, D(t), D(h), 1)
+        if s in (0, 1):
+            u[6] = t + h
+    elif call == "inder" and inputs:
+        v = rng.choice(inputs)
+        s = lib.fmi2SetRealInputDerivatives(c, (U * 1)(v.valueReference), 1, (I * 1)(rng.choice([1, 2])),
+                                            (D * 1)(rng.uniform(-1e-2, 1e-2)))
+    elif call == "outder":
+        v = rng.choice(outputs)
+        out = (D * 1)()
+        s = lib.fmi2GetRealOutputDerivatives(c, (U * 1)(v.valueReference), 1, (I * 1)(1), out)
+        if s == 0 and not math.isfinite(out[0]):
+            bad.append((name, n, "non-finite output derivative with fmi2OK"))
+    elif call == "dirder" and inputs:
+        v, w = rng.choice(outputs), rng.choice(inputs)
+        out = (D * 1)()
+        s = lib.fmi2GetDirectionalDerivative(c, (U * 1)(v.valueReference), 1, (U * 1)(w.valueReference), 1,
+                                             (D * 1)(1.0), out)
+        if s == 0 and not math.isfinite(out[0]):
+            bad.append((name, n, "non-finite directional derivative with fmi2OK"))
+    else:
+        continue
+    if s not in (0, 1, 2, 3):
+        bad.append((name, n, call, "status", s))
+    if s != 0 and len(msgs) == before:
+        bad.append((name, n, call, "status", s, "without a message"))
+for name, lib, md, c, *_ in units:
     lib.fmi2FreeInstance(c)
-    print(name, "statuses", steps)
+print("bad", bad)
 '''
 
 
 def test_every_fmu_instantiates_with_the_libraries_loaded_rtld_global(paths):
     # Issue 25: with RTLD_GLOBAL, dladdr on an exported function named the first library
     # loaded, so the other three refused their own GUIDs. All four in one process.
-    r = subprocess.run([sys.executable, "-c", RTLD_GLOBAL_SCRIPT] + [f"{n}={p}" for n, p in paths.items()],
-                       capture_output=True, text=True, timeout=120)
+    # Then 400 random calls over the four, the derivative functions among them late and
+    # in any order.
+    r = subprocess.run([sys.executable, "-c", RTLD_GLOBAL_SCRIPT, "25"] + [f"{n}={p}" for n, p in paths.items()],
+                       capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     lines = r.stdout.splitlines()
-    assert len(lines) == 4, r.stdout
-    for line in lines:
+    assert len(lines) == 5, r.stdout
+    for line in lines[:4]:
         assert line.endswith("statuses [0, 0, 0, 0]"), r.stdout
+    assert lines[4] == "bad []", r.stdout
 
 
 @pytest.mark.parametrize("name", ["RollPlaneVehicle", "HalfCarBogie"])
