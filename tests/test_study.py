@@ -142,6 +142,20 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
+def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, runner):
+    # Issue 26 item 8: a case within two spans of the fixed rail end reported 26 % above
+    # the endless track's peak with an empty error column. Its warning is now a column
+    # to filter on; the endless track's case has none.
+    p = tmp_path / "end.toml"
+    p.write_text('name = "end"\nduration = 0.74\n[fixed]\nspeed = 25.0\n[sweep]\n'
+                 '"track.window.ahead" = [0.0, 20.0]\n')
+    table, n = run_study(load_study(p), str(tmp_path / "end"), serial=True, runner_path=runner, progress=False,
+                         plots=False, log=lambda *_: None)
+    assert n == 2 and list(table["status"]) == ["ok", "ok"]
+    assert "within 2 sleeper spans of the fixed rail end" in table["warnings"][0]
+    assert table["warnings"][1] == ""
+
+
 @pytest.mark.parametrize("text, said", [
     ('name = "s"\nduration = 0.1\n[fixd]\nspeed = 20.0\n', "unknown keys ['fixd']"),
     ('name = "s"\nduration = 0.1\n[fixed]\nspeed = 20.0\n[sweep]\nspeed = [10.0]\n', "`speed` is both fixed and swept"),

@@ -51,6 +51,9 @@ def write_tables(study, cases, done, out_dir):
         row["duration"] = c.duration
         row["status"] = "error" if res.get("error") else "ok"
         row["error"] = res.get("error") or ""
+        # The FMU's warnings (the case ran, but read them: near a fixed rail end, say);
+        # a column to filter on.
+        row["warnings"] = " | ".join(res.get("warnings") or [])
         row.update(_flatten(res))
         row["version"] = res.get("version", "")
         row["guid"] = res.get("guid", "")

@@ -25,6 +25,8 @@
 //! * `bearing`: the primary (bearing) forces' extremes of the leading wheelset (N);
 //! * `contact_loss`: the time each leading wheel is out of contact (s);
 //! * `extremes`: the largest and smallest value of each `keep` output;
+//! * `warnings`: the FMU's warnings (fmi2Warning: the case ran, but near a fixed rail
+//!   end, say), each condition once;
 //! * `error`: null, or the refusal or failure in words (then the others may be
 //!   missing).
 
@@ -171,7 +173,25 @@ fn run(case: &Case) -> Result<String, String> {
         }
     }
     inst.enter_initialization().map_err(fail)?;
-    inst.exit_initialization().map_err(fail)?;
+    // The FMU's warnings (fmi2Warning: the call went through), once each, for the
+    // JSON line; an error ends the case.
+    let mut warnings: Vec<String> = Vec::new();
+    let warned = |r: wheelflat::fmu::FmiResult,
+                  warnings: &mut Vec<String>|
+     -> Result<(), wheelflat::fmu::Refusal> {
+        match r {
+            Err(e) if e.status == wheelflat::fmu::Status::Warning => {
+                // A condition that still holds is logged as "still: <kind>" after its
+                // first message: one entry per condition.
+                if !e.message.contains(" still: ") && !warnings.contains(&e.message) {
+                    warnings.push(e.message);
+                }
+                Ok(())
+            }
+            other => other,
+        }
+    };
+    warned(inst.exit_initialization(), &mut warnings).map_err(fail)?;
     let value = |inst: &mut Instance, name: &str| -> Result<f64, String> {
         let s = spec(name)?;
         let mut x = [0.0];
@@ -290,7 +310,7 @@ fn run(case: &Case) -> Result<String, String> {
         if step == n {
             break;
         }
-        inst.do_step(t, h).map_err(|e| {
+        warned(inst.do_step(t, h), &mut warnings).map_err(|e| {
             let logged = last(&log);
             if logged.is_empty() { e.message } else { logged }
         })?;
@@ -354,7 +374,11 @@ fn run(case: &Case) -> Result<String, String> {
         })
         .collect();
     o.push_str(&list.join(","));
-    o.push_str("},\"error\":null}");
+    let list: Vec<String> = warnings.iter().map(|w| json_str(w)).collect();
+    o.push_str(&format!(
+        "}},\"warnings\":[{}],\"error\":null}}",
+        list.join(",")
+    ));
     Ok(o)
 }
 
