@@ -142,6 +142,17 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
+def test_a_duration_that_runs_no_step_is_refused_with_the_least_one(runner):
+    # Issue 26 item 9: shorter than half a step, no step ran and the static state came
+    # back as the result.
+    import json
+    r = subprocess.run([runner], input="speed=20 duration=5e-6\nspeed=20 duration=8e-6\n", capture_output=True,
+                       text=True, timeout=60)
+    short, enough = [json.loads(x) for x in r.stdout.splitlines()]
+    assert "shorter than half the track's step" in short["error"] and "at least 7.2065" in short["error"], short
+    assert enough["error"] is None and enough["steps"] == 1
+
+
 def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, runner):
     # Issue 26 item 8: a case within two spans of the fixed rail end reported 26 % above
     # the endless track's peak with an empty error column. Its warning is now a column
@@ -167,6 +178,12 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
      "speed: 2, wheel.radius: 1"),
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [20.0, 300.0]\n', "`speed` = 300 is out of range: 0 <= speed <= 200"),
     ('name = "s"\nduration = 0.1\n[sweep]\n"vehicle.mass" = [1.0]\n', "`vehicle.mass` is not a parameter"),
+    # Issue 26 item 3: a kept name with a blank injected a parameter into every case; with
+    # a newline it shifted the runner's answers by one case.
+    ('name = "s"\nduration = 0.1\nkeep = ["primary.left.force flat.left[1].depth=0.004"]\n',
+     "keep `primary.left.force flat.left[1].depth=0.004` is not a Real output of CoupledSystem"),
+    ('name = "s"\nduration = 0.1\nkeep = ["primary.left.force\\nspeed=1"]\n', "is not a Real output of CoupledSystem"),
+    ('name = "s"\nduration = 0.1\nkeep = ["speed"]\n', "keep `speed` is not a Real output"),
 ])
 def test_bad_study_files_are_refused_before_anything_runs(tmp_path, runner, text, said):
     p = tmp_path / "s.toml"

@@ -66,10 +66,18 @@ def check_variables(study, runner):
     outside its range (as fmi2SetReal would), naming both."""
     import subprocess
     listing = subprocess.run([runner, "--variables"], capture_output=True, text=True, check=True).stdout
-    known = {}
+    known, outputs = {}, set()
     for line in listing.splitlines():
         name, ty, lo, hi = line.split("\t")
-        known[name] = (ty, float(lo), float(hi))
+        if ty == "output":
+            outputs.add(name)
+        else:
+            known[name] = (ty, float(lo), float(hi))
+    # A kept name goes into the runner's line as it is: one that is not an output (a
+    # blank in it, another token, a newline) would set a parameter or shift the answers.
+    for name in study.keep:
+        if name not in outputs:
+            raise ValueError(f"keep `{name}` is not a Real output of CoupledSystem (docs/VARIABLES.md)")
     values = dict((k, [v]) for k, v in study.fixed.items())
     values.update(study.sweep)
     for name, vs in values.items():

@@ -33,6 +33,7 @@
 use std::io::{BufRead, Write};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
+use wheelflat::error::num;
 use wheelflat::fmu::vars::{Causality, VarSpec, VarType};
 use wheelflat::fmu::{Instance, Kind, Logger};
 
@@ -258,6 +259,16 @@ fn run(case: &Case) -> Result<String, String> {
     let mut open: Vec<Option<Impact>> = flats.iter().map(|_| None).collect();
     let mut before: Vec<f64> = vec![f64::NAN; flats.len()];
     let n = (case.duration / h).round() as u64;
+    // A duration that rounds to no step would return the static state as the result.
+    if n == 0 {
+        return Err(format!(
+            "duration = {} s is shorter than half the track's step solver.step = {} s, so no \
+             step would run: give at least {} s",
+            num(case.duration),
+            num(h),
+            num(0.5 * h)
+        ));
+    }
     for step in 0..=n {
         let t = step as f64 * h;
         inst.get_real(&vrs, &mut x).map_err(|e| e.message)?;
@@ -383,7 +394,8 @@ fn run(case: &Case) -> Result<String, String> {
 }
 
 /// `--variables`: CoupledSystem's parameters and inputs, one per line: name, type,
-/// min, max (for the sweep command's checks before a study starts).
+/// min, max; then its Real outputs (what `keep` may name): name, `output`, `-`, `-`
+/// (for the sweep command's checks before a study starts).
 fn list_variables() {
     let mut out = std::io::stdout().lock();
     for v in Kind::CoupledSystem.table().vars {
@@ -393,6 +405,11 @@ fn list_variables() {
                 _ => "Integer",
             };
             let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}", v.name, v.min, v.max);
+        }
+    }
+    for v in Kind::CoupledSystem.table().vars {
+        if v.causality == Causality::Output && v.ty == VarType::Real {
+            let _ = writeln!(out, "{}\toutput\t-\t-", v.name);
         }
     }
 }
