@@ -142,6 +142,33 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
+def test_a_chunk_or_worker_count_below_one_is_refused(tmp_path, study, runner):
+    # Issue 26 item 4: `--chunk -5` printed "ran 3 cases" and ran none.
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    for flag in ("--chunk", "--workers"):
+        r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(study), flag, "-5", "--out",
+                            str(tmp_path / "o"), "--runner", runner, "--no-progress"], env=env,
+                           capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and f"{flag} -5: at least 1" in r.stderr, r.stderr
+
+
+def test_the_tables_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
+    # Issue 26 item 6: a full disk left results.csv cut mid-number. A write that fails
+    # leaves the previous table as it was and no temporary file.
+    from wheelflat_study import tables
+    path = tmp_path / "results.csv"
+    path.write_text("old,table\n1,2\n")
+
+    def failing(p):
+        with open(p, "w") as fh:
+            fh.write("new,tab")
+        raise OSError(28, "No space left on device", p)
+    with pytest.raises(OSError):
+        tables._atomic(str(path), failing)
+    assert path.read_text() == "old,table\n1,2\n"
+    assert os.listdir(tmp_path) == ["results.csv"]
+
+
 def test_a_duration_that_runs_no_step_is_refused_with_the_least_one(runner):
     # Issue 26 item 9: shorter than half a step, no step ran and the static state came
     # back as the result.
@@ -184,6 +211,11 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
      "keep `primary.left.force flat.left[1].depth=0.004` is not a Real output of CoupledSystem"),
     ('name = "s"\nduration = 0.1\nkeep = ["primary.left.force\\nspeed=1"]\n', "is not a Real output of CoupledSystem"),
     ('name = "s"\nduration = 0.1\nkeep = ["speed"]\n', "keep `speed` is not a Real output"),
+    # Issue 26 items 4 and 11.
+    ('name = "s"\nduration = 0.1\ncombine = "zip"\n', "combine = zip without a [sweep]"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [0.0, -0.0]\n', "the same case twice"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [1.0]\n[[plot]]\nname = "../../../x"\nkind = "lines"\nx = "speed"\n'
+     'y = ["peak.left"]\n', "plot 1: name = `../../../x`"),
 ])
 def test_bad_study_files_are_refused_before_anything_runs(tmp_path, runner, text, said):
     p = tmp_path / "s.toml"

@@ -31,6 +31,10 @@ def main(argv=None):
                     help="run again the cases that failed (those that failed for a passing reason, "
                          "a stopped runner or a lost worker, always run again)")
     args = ap.parse_args(argv)
+    for flag, v in (("--chunk", args.chunk), ("--workers", args.workers)):
+        if v is not None and v < 1:
+            print(f"{flag} {v}: at least 1", file=sys.stderr)
+            return 2
     try:
         study = load_study(args.study)
     except (OSError, ValueError) as e:
@@ -55,6 +59,14 @@ def main(argv=None):
     except RuntimeError as e:
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
+    except OSError as e:
+        import errno
+        if e.errno == errno.ENOSPC:
+            print(f"{args.study}: disk full while writing into {out} ({e.filename or 'a results file'}): "
+                  f"free some space and run the same command again; the cases done so far are kept",
+                  file=sys.stderr)
+            return 1
+        raise
     failed = int((table["status"] == "error").sum()) if len(table) else 0
     print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {len(cases)} cases, "
           f"{failed} failed)")

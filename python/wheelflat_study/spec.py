@@ -141,7 +141,8 @@ def _values(name, entry):
     if not values:
         raise ValueError(f"sweep `{name}`: no values")
     f = UNITS[unit]
-    return [_number(where, v) * f for v in values], unit
+    # + 0.0 makes -0.0 the 0.0 it is (else the same physics ran as two cases).
+    return [_number(where, v) * f + 0.0 for v in values], unit
 
 
 def load_study(path):
@@ -172,7 +173,7 @@ def load_study(path):
             unit = _unit(f"fixed `{var}`", entry.get("unit"))
             fixed[var] = _number(f"fixed `{var}`", entry["value"]) * UNITS[unit]
         else:
-            fixed[var] = _number(f"fixed `{var}`", entry)
+            fixed[var] = _number(f"fixed `{var}`", entry) + 0.0
     sweep = {}
     for var, entry in d.get("sweep", {}).items():
         if var in fixed:
@@ -183,11 +184,18 @@ def load_study(path):
     combine = d.get("combine", "product")
     if combine not in ("product", "zip"):
         raise ValueError(f"combine = `{combine}`: product or zip")
+    if combine == "zip" and not sweep:
+        raise ValueError("combine = zip without a [sweep]: there is nothing to zip")
     keep = d.get("keep", [])
     if not isinstance(keep, list) or not all(isinstance(k, str) and k for k in keep):
         raise ValueError("keep: a list of output names")
     plots = d.get("plot", [])
     for i, p in enumerate(plots):
+        pname = p.get("name")
+        if pname is not None and (not isinstance(pname, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", pname)
+                                  or pname.startswith(".")):
+            raise ValueError(f"plot {i + 1}: name = `{pname}`: letters, digits, '_', '.', '-' (it names a file "
+                             f"in the results folder)")
         kind = p.get("kind", "lines")
         if kind not in PLOT_KINDS or set(p) - PLOT_KEYS:
             raise ValueError(f"plot {i + 1}: kind one of {sorted(PLOT_KINDS)}, keys {sorted(PLOT_KEYS)}")

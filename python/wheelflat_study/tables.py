@@ -75,6 +75,22 @@ def write_tables(study, cases, done, out_dir):
     for name, df in (("results", table), ("impacts", pd.DataFrame(impacts))):
         t = pa.Table.from_pandas(df, preserve_index=False)
         t = t.replace_schema_metadata({**(t.schema.metadata or {}), **meta})
-        pq.write_table(t, os.path.join(out_dir, f"{name}.parquet"))
-        df.to_csv(os.path.join(out_dir, f"{name}.csv"), index=False, float_format="%.17g")
+        # Each table whole or not at all: written beside, then renamed over the old one
+        # (a full disk left results.csv cut mid-number, which pandas read without a word).
+        _atomic(os.path.join(out_dir, f"{name}.parquet"), lambda p: pq.write_table(t, p))
+        _atomic(os.path.join(out_dir, f"{name}.csv"),
+                lambda p: df.to_csv(p, index=False, float_format="%.17g"))
     return table
+
+
+def _atomic(path, write):
+    """Calls ``write(tmp)`` for a temporary file beside ``path``, then renames it to
+    ``path``; the temporary file is removed if the write fails."""
+    tmp = path + ".part"
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
