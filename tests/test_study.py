@@ -142,6 +142,56 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
+LOSING_RUNNER = """#!{python}
+import subprocess, sys
+child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                         bufsize=1)
+if sys.argv[1:]:
+    sys.stdout.write(child.communicate()[0])
+    sys.exit(0)
+for line in sys.stdin:
+    if "speed=30" in line:
+        sys.exit(9)   # a runner killed on this case: no answer
+    child.stdin.write(line)
+    child.stdin.flush()
+    sys.stdout.write(child.stdout.readline())
+    sys.stdout.flush()
+"""
+
+
+def test_a_case_without_a_result_is_a_failure_and_runs_next_time(tmp_path, runner):
+    # Issue 26 item 1: killed runners' cases were left out with "195 of 200 cases, 0
+    # failed" and exit status 0.
+    losing = tmp_path / "losing_runner"
+    losing.write_text(LOSING_RUNNER.format(python=sys.executable, runner=runner))
+    losing.chmod(0o755)
+    p = tmp_path / "lost.toml"
+    p.write_text('name = "lost"\nduration = 0.01\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
+           "--no-progress", "--no-plots", "--runner"]
+    r = subprocess.run(cmd + [str(losing)], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1, (r.stdout, r.stderr)
+    assert "2 of 3 cases, 0 failed, 1 without a result" in r.stdout, r.stdout
+    r = subprocess.run(cmd + [runner], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "1 to run" in r.stdout and "3 of 3 cases, 0 failed)" in r.stdout, r.stdout
+
+
+def test_two_runs_on_one_folder_at_once_are_refused(tmp_path, study, runner):
+    # Issue 26 item 7: two runs on one folder each computed every case.
+    import fcntl
+    out = tmp_path / "o"
+    out.mkdir()
+    with open(out / ".lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+        r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(study), "--serial", "--out", str(out),
+                            "--runner", runner, "--no-progress"], env=env, capture_output=True, text=True,
+                           timeout=60)
+    assert r.returncode == 2 and "another run is writing into" in r.stderr, r.stderr
+    assert not (out / "cases.jsonl").exists()
+
+
 def test_a_chunk_or_worker_count_below_one_is_refused(tmp_path, study, runner):
     # Issue 26 item 4: `--chunk -5` printed "ran 3 cases" and ran none.
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))

@@ -68,8 +68,13 @@ def main(argv=None):
             return 1
         raise
     failed = int((table["status"] == "error").sum()) if len(table) else 0
+    # A case with no result (its runner or worker lost) is a failure too: it runs the
+    # next time the same command runs.
+    missing = len(cases) - len(table)
     print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {len(cases)} cases, "
-          f"{failed} failed)")
+          f"{failed} failed" + (f", {missing} without a result: run the same command again to run them"
+                                if missing else "") + ")")
+    failed += missing
     return 1 if failed else 0
 
 

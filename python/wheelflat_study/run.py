@@ -45,9 +45,14 @@ class CaseRunner:
         else:
             why = "no answer"
         if not out:
-            code = self.proc.poll()
+            try:
+                code = self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                code = self.proc.wait()
             self.proc = None
-            return {"error": f"the case runner stopped ({why}, exit status {code})", "transient": True}
+            how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
+            return {"error": f"the case runner stopped ({why}, {how})", "transient": True}
         return json.loads(out)
 
 
@@ -132,6 +137,22 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
     this process. Returns (the results table, the number of cases run now); the
     times of the last run (start-up, the cases, the tables) are in `run_study.timing`."""
     os.makedirs(out_dir, exist_ok=True)
+    # One run per folder: a second one at the same time would compute every case again
+    # and interleave the records.
+    import fcntl
+    with open(os.path.join(out_dir, ".lock"), "w") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise RuntimeError(f"another run is writing into {out_dir}: wait for it to end, or give "
+                               f"another --out") from None
+        return _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, progress, plots,
+                           log, retry_failed)
+
+
+def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, progress, plots, log,
+                retry_failed):
+    """:func:`run_study` with the folder's lock held."""
     runner_path = runner_path or RUNNER
     cases = study.cases()
     ids = [c.id for c in cases]
@@ -221,8 +242,9 @@ def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress
         for fut in as_completed(futures):
             try:
                 results = fut.result()
-            except Exception as e:  # a lost worker or task: its cases are recorded as failed
-                results = [(cid, {"error": f"{type(e).__name__}: {e}"}, 0.0) for cid, _ in meta[fut.key]]
+            except Exception as e:  # a lost worker or task: its cases run again next time
+                results = [(cid, {"error": f"{type(e).__name__}: {e}", "transient": True}, 0.0)
+                           for cid, _ in meta[fut.key]]
             _append(out_dir, [_record(cid, res, wall, by_id[cid]) for cid, res, wall in results])
             if bar:
                 bar.update(len(results))
