@@ -219,6 +219,18 @@ def test_the_tables_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
     assert os.listdir(tmp_path) == ["results.csv"]
 
 
+def test_the_runner_names_the_range_and_the_variable_a_user_sets(runner):
+    # Issue 26 item 14: "`wheelsets` = 2147483648: a whole number is needed"; the
+    # half-car's refusal named vehicle.wheelbase, which CoupledSystem does not have.
+    import json
+    r = subprocess.run([runner], input="wheelsets=2147483648 duration=0.01\n"
+                       "vehicle.model=2 wheelsets=2 wheelset[2].offset=0.5 duration=0.01\n",
+                       capture_output=True, text=True, timeout=60)
+    big, short = [json.loads(x)["error"] for x in r.stdout.splitlines()]
+    assert big == "`wheelsets` = 2147483648 is out of range: 1 <= wheelsets <= 4", big
+    assert "`wheelset[2].offset` = 0.5 is out of range" in short and "vehicle.wheelbase" not in short, short
+
+
 def test_a_duration_that_runs_no_step_is_refused_with_the_least_one(runner):
     # Issue 26 item 9: shorter than half a step, no step ran and the static state came
     # back as the result.
@@ -261,6 +273,9 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
      "keep `primary.left.force flat.left[1].depth=0.004` is not a Real output of CoupledSystem"),
     ('name = "s"\nduration = 0.1\nkeep = ["primary.left.force\\nspeed=1"]\n', "is not a Real output of CoupledSystem"),
     ('name = "s"\nduration = 0.1\nkeep = ["speed"]\n', "keep `speed` is not a Real output"),
+    # Issue 26 item 14: a half-integer random n was reported as n = 0.
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { random = { low = 1, high = 2, n = 0.5 } }\n',
+     "random n = 0.5; allowed a whole number"),
     # Issue 26 items 4 and 11.
     ('name = "s"\nduration = 0.1\ncombine = "zip"\n', "combine = zip without a [sweep]"),
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [0.0, -0.0]\n', "the same case twice"),

@@ -128,9 +128,10 @@ def _values(name, entry):
             r = entry["random"]
             if not isinstance(r, dict) or set(r) - RANDOM_KEYS or not {"low", "high", "n"} <= set(r):
                 raise ValueError(f"{where}: random = {{ low, high, n, seed }} (seed optional)")
-            n = int(_number(where, r["n"]))
-            if not 1 <= n <= MAX_CASES:
-                raise ValueError(f"{where}: random n = {n}; allowed 1 to {MAX_CASES}")
+            n = _number(where, r["n"])
+            if n != int(n) or not 1 <= n <= MAX_CASES:
+                raise ValueError(f"{where}: random n = {r['n']}; allowed a whole number, 1 to {MAX_CASES}")
+            n = int(n)
             rng = random.Random(r.get("seed", 0))
             low, high = _number(where, r["low"]), _number(where, r["high"])
             values = [rng.uniform(low, high) for _ in range(n)]

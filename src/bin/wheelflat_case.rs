@@ -166,8 +166,15 @@ fn run(case: &Case) -> Result<String, String> {
         match s.ty {
             VarType::Real => inst.set_real(&[s.vr], &[*x]).map_err(fail)?,
             _ => {
-                if x.fract() != 0.0 || x.abs() > i32::MAX as f64 {
+                if x.fract() != 0.0 {
                     return Err(format!("`{name}` = {x}: a whole number is needed"));
+                }
+                if !(s.min..=s.max).contains(x) {
+                    return Err(format!(
+                        "`{name}` = {x} is out of range: {} <= {name} <= {}",
+                        num(s.min),
+                        num(s.max)
+                    ));
                 }
                 inst.set_integer(&[s.vr], &[*x as i32]).map_err(fail)?
             }

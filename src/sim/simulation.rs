@@ -404,6 +404,25 @@ impl Simulation {
     /// wheel load; a static state beyond the health bounds.
     pub fn new(scenario: &Scenario) -> Result<Self> {
         let s = scenario;
+        // The half-car bogie's wheelbase is the second wheelset's offset here: a refusal
+        // names that, the variable a user of the scenario (CoupledSystem) sets.
+        if let VehicleSpec::HalfCar(p) = &s.vehicle {
+            p.validate().map_err(|e| match e {
+                Error::Parameter {
+                    name,
+                    value,
+                    allowed,
+                } if name == "vehicle.wheelbase" => Error::Parameter {
+                    name: "wheelset[2].offset".into(),
+                    value,
+                    allowed: format!(
+                        "{} (the half-car bogie's wheelbase)",
+                        allowed.replace("vehicle.wheelbase", "wheelset[2].offset")
+                    ),
+                },
+                other => other,
+            })?;
+        }
         positive("wheel.radius", s.wheel_radius, "m")?;
         finite("speed", s.speed, "m/s")?;
         if s.speed < 0.0 {
