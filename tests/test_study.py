@@ -177,6 +177,28 @@ def test_a_case_without_a_result_is_a_failure_and_runs_next_time(tmp_path, runne
     assert r.returncode == 0 and "1 to run" in r.stdout and "3 of 3 cases, 0 failed)" in r.stdout, r.stdout
 
 
+def test_results_of_another_version_or_model_are_run_again_not_mixed(study, tmp_path, runner):
+    # Issue 26 item 5: a resumed study reused results of another software version or GUID
+    # without a word and mixed them into one table.
+    import json
+    s = load_study(study)
+    out = tmp_path / "o"
+    whole, _ = run_study(s, str(out), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=lambda *_: None)
+    lines = (out / "cases.jsonl").read_text().splitlines()
+    rec = json.loads(lines[1])
+    rec["result"]["guid"] = "{00000000-0000-0000-0000-000000000000}"
+    rec["result"]["peak"]["left"] = 1.0
+    lines[1] = json.dumps(rec)
+    (out / "cases.jsonl").write_text("\n".join(lines) + "\n")
+    said = []
+    again, n = run_study(s, str(out), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=said.append)
+    assert n == 1 and any("1 results of another software version or model GUID" in x for x in said), said
+    assert set(again["guid"]) == set(whole["guid"]) and len(set(again["guid"])) == 1
+    assert comparable(again).equals(comparable(whole))
+
+
 def test_two_runs_on_one_folder_at_once_are_refused(tmp_path, study, runner):
     # Issue 26 item 7: two runs on one folder each computed every case.
     import fcntl

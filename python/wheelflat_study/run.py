@@ -86,11 +86,22 @@ def _chunks(items, size):
     return [items[i:i + size] for i in range(0, len(items), size)]
 
 
-def load_done(out_dir, retry_failed=False):
+def identity(runner_path):
+    """The software version and CoupledSystem's GUID of the case runner at
+    `runner_path` (from its answer to a case it refuses)."""
+    r = subprocess.run([runner_path], input="duration=0\n", capture_output=True, text=True, timeout=60)
+    rec = json.loads(r.stdout.splitlines()[0])
+    return rec.get("version"), rec.get("guid")
+
+
+def load_done(out_dir, retry_failed=False, ident=None):
     """The results already in the study's folder, by case id. Lines that are not a
     whole record (cut by an interruption, or damaged) are skipped, so their cases run
     again; so do cases that failed for a passing reason (a stopped runner, a lost
-    worker) and, with `retry_failed`, every failed case."""
+    worker), with `retry_failed` every failed case, and, given `ident` (version, GUID),
+    results of another software version or GUID (one table holds one model's
+    results); `load_done.other` counts those."""
+    load_done.other = 0
     path = os.path.join(out_dir, "cases.jsonl")
     done = {}
     if os.path.exists(path):
@@ -106,6 +117,11 @@ def load_done(out_dir, retry_failed=False):
                 res = rec["result"]
                 if res.get("error") and (res.get("transient") or retry_failed):
                     done.pop(rec["id"], None)
+                    continue
+                if ident is not None and res.get("version") is not None \
+                        and (res.get("version"), res.get("guid")) != tuple(ident):
+                    done.pop(rec["id"], None)
+                    load_done.other += 1
                     continue
                 done[rec["id"]] = rec
     return done
@@ -158,7 +174,11 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
         raise ValueError("the study has duplicate cases")
-    done = load_done(out_dir, retry_failed)
+    ident = identity(runner_path)
+    done = load_done(out_dir, retry_failed, ident)
+    if load_done.other:
+        log(f"{study.name}: {load_done.other} results of another software version or model GUID in "
+            f"{out_dir} are set aside and run again (this runner: version {ident[0]}, GUID {ident[1]})")
     todo = [(c.id, c.line()) for c in cases if c.id not in done]
     by_id = {c.id: c for c in cases}
     log(f"{study.name}: {len(cases)} cases, {len(cases) - len(todo)} already done, {len(todo)} to run")
@@ -174,7 +194,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     if todo:
         log(f"ran {len(todo)} cases in {elapsed:.2f} s ({60 * len(todo) / elapsed:.0f} cases per minute)")
     from .tables import write_tables
-    table = write_tables(study, cases, load_done(out_dir), out_dir)
+    table = write_tables(study, cases, load_done(out_dir, ident=ident), out_dir)
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:
