@@ -214,6 +214,15 @@ def test_two_runs_on_one_folder_at_once_are_refused(tmp_path, study, runner):
     assert not (out / "cases.jsonl").exists()
 
 
+def test_a_runner_that_is_not_there_is_refused(tmp_path, study):
+    # Issue 26 item 10: a missing --runner gave a traceback with exit status 1.
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(study), "--serial", "--out", str(tmp_path / "o"),
+                        "--runner", str(tmp_path / "nowhere"), "--no-progress"], env=env, capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "not an executable file" in r.stderr, r.stderr
+
+
 def test_a_chunk_or_worker_count_below_one_is_refused(tmp_path, study, runner):
     # Issue 26 item 4: `--chunk -5` printed "ran 3 cases" and ran none.
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
@@ -298,6 +307,15 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
     # Issue 26 item 14: a half-integer random n was reported as n = 0.
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { random = { low = 1, high = 2, n = 0.5 } }\n',
      "random n = 0.5; allowed a whole number"),
+    # Issue 26 item 10: these gave tracebacks with exit status 1.
+    ('name = "s"\nduration = 0.1\nplot = [1]\n', "plot: tables, one [[plot]] each"),
+    ('name = "s"\nduration = 0.1\nfixed = 5\n', "`fixed` = 5: a table"),
+    ('name = "s"\nduration = 0.1\nsweep = [1, 2]\n', "`sweep` = [1, 2]: a table"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { range = 5 }\n', "range = [start, stop, step]"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { range = [0, 1e308, 1e-308] }\n', "range gives inf values"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [' + "9" * 300 + ']\n', "`speed` = 1e+300 is out of range"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { random = { low = 1, high = 2, n = 2, seed = [1] } }\n',
+     "random seed = [1]; a whole number"),
     # Issue 26 items 4 and 11.
     ('name = "s"\nduration = 0.1\ncombine = "zip"\n', "combine = zip without a [sweep]"),
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [0.0, -0.0]\n', "the same case twice"),

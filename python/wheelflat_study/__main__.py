@@ -41,6 +41,10 @@ def main(argv=None):
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
     runner = args.runner or build_runner()
+    if not (os.path.isfile(runner) and os.access(runner, os.X_OK)):
+        print(f"--runner {runner}: not an executable file (the case runner, target/release/wheelflat_case)",
+              file=sys.stderr)
+        return 2
     try:
         check_variables(study, runner)
         cases = study.cases()

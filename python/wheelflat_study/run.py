@@ -234,7 +234,10 @@ def _serial(todo, by_id, out_dir, runner_path, progress):
 def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress):
     from dask.distributed import Client, LocalCluster, as_completed
     if scheduler:
-        client = Client(scheduler, timeout=60)
+        try:
+            client = Client(scheduler, timeout=60)
+        except OSError as e:
+            raise RuntimeError(f"cannot reach the scheduler {scheduler}: {e}") from None
         cluster = None
         try:
             client.wait_for_workers(1, timeout=120)

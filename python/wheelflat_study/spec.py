@@ -117,10 +117,16 @@ def _values(name, entry):
             values = entry["values"]
         elif "range" in entry:
             r = entry["range"]
-            if len(r) != 3 or not r[2] > 0:
+            if not isinstance(r, list) or len(r) != 3:
                 raise ValueError(f"sweep `{name}`: range = [start, stop, step] with step > 0")
             start, stop, step = (_number(where, x) for x in r)
-            n = int(math.floor((stop - start) / step + 1e-9)) + 1
+            if not step > 0:
+                raise ValueError(f"sweep `{name}`: range = [start, stop, step] with step > 0")
+            count = math.floor((stop - start) / step + 1e-9) + 1 if math.isfinite((stop - start) / step) \
+                else math.inf
+            if not count <= MAX_CASES:
+                raise ValueError(f"{where}: range gives {count:g} values; at most {MAX_CASES} cases a study")
+            n = int(count)
             if n > MAX_CASES:
                 raise ValueError(f"{where}: range gives {n} values; at most {MAX_CASES} cases a study")
             values = [start + i * step for i in range(n)]
@@ -132,7 +138,10 @@ def _values(name, entry):
             if n != int(n) or not 1 <= n <= MAX_CASES:
                 raise ValueError(f"{where}: random n = {r['n']}; allowed a whole number, 1 to {MAX_CASES}")
             n = int(n)
-            rng = random.Random(r.get("seed", 0))
+            seed = r.get("seed", 0)
+            if isinstance(seed, bool) or not isinstance(seed, int):
+                raise ValueError(f"{where}: random seed = {seed!r}; a whole number")
+            rng = random.Random(seed)
             low, high = _number(where, r["low"]), _number(where, r["high"])
             values = [rng.uniform(low, high) for _ in range(n)]
         else:
@@ -165,6 +174,9 @@ def load_study(path):
     duration = _number("duration", d["duration"])
     if not 0 < duration <= 1e4:
         raise ValueError(f"duration = {duration}: 0 < duration <= 1e4 s")
+    for key in ("fixed", "sweep"):
+        if not isinstance(d.get(key, {}), dict):
+            raise ValueError(f"`{key}` = {d[key]!r}: a table, [{key}] with one variable a line")
     fixed = {}
     display = {}
     for var, entry in d.get("fixed", {}).items():
@@ -191,6 +203,8 @@ def load_study(path):
     if not isinstance(keep, list) or not all(isinstance(k, str) and k for k in keep):
         raise ValueError("keep: a list of output names")
     plots = d.get("plot", [])
+    if not isinstance(plots, list) or not all(isinstance(p, dict) for p in plots):
+        raise ValueError("plot: tables, one [[plot]] each")
     for i, p in enumerate(plots):
         pname = p.get("name")
         if pname is not None and (not isinstance(pname, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", pname)
