@@ -136,6 +136,27 @@ impl fmt::Display for Error {
     }
 }
 
+impl Error {
+    /// A parameter refusal of `from` told as one of `to`, the variable that carries the
+    /// value where the caller is (the half-car bogie's `vehicle.wheelbase` is
+    /// `wheelset[2].offset` of a track with two wheelsets), with `note` after the allowed
+    /// range; any other error as it is.
+    pub fn renamed(self, from: &str, to: &str, note: &str) -> Error {
+        match self {
+            Error::Parameter {
+                name,
+                value,
+                allowed,
+            } if name == from => Error::Parameter {
+                name: to.into(),
+                value,
+                allowed: format!("{} {note}", allowed.replace(from, to)),
+            },
+            other => other,
+        }
+    }
+}
+
 impl std::error::Error for Error {}
 
 /// Result alias for the engine.

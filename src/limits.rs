@@ -72,6 +72,8 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("vehicle.secondary.stiffness", 1e4, 1e10, "N/m"),
     r("vehicle.secondary.damping", 0.0, 1e7, "N s/m"),
     r("vehicle.secondary.spacing", 0.1, 3.0, "m"),
+    r("vehicle.wheelbase", 1.0, 5.0, "m"),
+    r("vehicle.sideframe.pitch_inertia", 1.0, 1e5, "kg m^2"),
     r("gravity", 0.0, 100.0, "m/s^2"),
     r("static_load.left", 0.0, 2e6, "N"),
     r("static_load.right", 0.0, 2e6, "N"),

@@ -457,13 +457,7 @@ impl SideFrameSpec {
                 pitch_inertia,
             } => {
                 crate::limits::check("vehicle.sideframe.mass", 0.5 * mass)?;
-                if !(1.0..=1e5).contains(&pitch_inertia) {
-                    return Err(out_of_range(
-                        "vehicle.sideframe.pitch_inertia",
-                        pitch_inertia,
-                        "1 kg m^2 <= vehicle.sideframe.pitch_inertia <= 1e5 kg m^2",
-                    ));
-                }
+                crate::limits::check("vehicle.sideframe.pitch_inertia", pitch_inertia)?;
                 if s.trailing.len() != 1 {
                     return Err(out_of_range(
                         "wheelsets",
@@ -473,14 +467,14 @@ impl SideFrameSpec {
                     ));
                 }
                 let wheelbase = s.trailing[0].offset;
-                if !(1.0..=5.0).contains(&wheelbase) {
-                    return Err(out_of_range(
+                crate::limits::check("vehicle.wheelbase", wheelbase).map_err(|e| {
+                    e.renamed(
+                        "vehicle.wheelbase",
                         "wheelset[2].offset",
-                        wheelbase,
-                        "the half-car bogie's wheelbase, 1 m <= wheelset[2].offset <= 5 m, \
-                         with vehicle.model = half_car at the axle boxes",
-                    ));
-                }
+                        "(the half-car bogie's wheelbase, with vehicle.model = half_car at the \
+                         axle boxes)",
+                    )
+                })?;
                 Ok((
                     SideFrameInertia::pitching(mass, pitch_inertia, wheelbase),
                     true,

@@ -407,20 +407,12 @@ impl Simulation {
         // The half-car bogie's wheelbase is the second wheelset's offset here: a refusal
         // names that, the variable a user of the scenario (CoupledSystem) sets.
         if let VehicleSpec::HalfCar(p) = &s.vehicle {
-            p.validate().map_err(|e| match e {
-                Error::Parameter {
-                    name,
-                    value,
-                    allowed,
-                } if name == "vehicle.wheelbase" => Error::Parameter {
-                    name: "wheelset[2].offset".into(),
-                    value,
-                    allowed: format!(
-                        "{} (the half-car bogie's wheelbase)",
-                        allowed.replace("vehicle.wheelbase", "wheelset[2].offset")
-                    ),
-                },
-                other => other,
+            p.validate().map_err(|e| {
+                e.renamed(
+                    "vehicle.wheelbase",
+                    "wheelset[2].offset",
+                    "(the half-car bogie's wheelbase)",
+                )
             })?;
         }
         positive("wheel.radius", s.wheel_radius, "m")?;
