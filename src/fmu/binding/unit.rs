@@ -641,12 +641,10 @@ impl Model for FmuModel {
         let mut contact = None;
         if self.kind == Kind::TrackContact && matches!(sim.vehicle(), VehicleState::External { .. })
         {
-            let n = sim.wheelsets().len();
-            let forces: Vec<[f64; 2]> = (0..n)
-                .map(|k| sim.wheelsets().get(k).map_or([0.0; 2], |w| w.forces()))
-                .collect();
             let load = sim.static_load()[0].max(sim.static_load()[1]);
-            let chatter = self.watch.forces_at_point(&forces, load);
+            // No list built at every step: the wheelsets' forces as they come.
+            let forces = sim.wheelsets().iter().map(|w| w.forces());
+            let chatter = self.watch.forces_at_point(forces, load);
             let jump = self.watch.take_jump(load);
             let held = !sim.wheelsets().iter().any(|w| match w.vehicle() {
                 VehicleState::External { rates, .. } => rates.moves(),

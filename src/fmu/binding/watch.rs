@@ -41,6 +41,28 @@ const RATE_TOLERANCE: f64 = 0.01;
 const RATE_FLOOR: f64 = 0.05;
 const RATE_WINDOW: f64 = 64.0;
 
+/// The name of wheelset `k`'s (0 the leading one) variable `what`: `wheel.rotation`,
+/// `wheelset[2].contact.left.force`.
+fn named(k: usize, what: &str) -> String {
+    if k == 0 {
+        what.to_string()
+    } else {
+        format!("wheelset[{}].{what}", k + 1)
+    }
+}
+
+/// The contact force's name of wheelset `k`'s wheel on side `s` (0 left, 1 right).
+fn force_name(k: usize, s: usize) -> String {
+    named(
+        k,
+        if s == 0 {
+            "contact.left.force"
+        } else {
+            "contact.right.force"
+        },
+    )
+}
+
 /// One wheel's contact forces at the communication points.
 #[derive(Debug, Clone, Copy, Default)]
 struct Wheel {
@@ -90,13 +112,7 @@ impl ContactWatch {
         for s in 0..2 {
             let d = (after[s] - before[s]).abs();
             if self.jump.as_ref().is_none_or(|(j, _)| d > *j) {
-                let side = if s == 0 { "left" } else { "right" };
-                let name = if k == 0 {
-                    format!("contact.{side}.force")
-                } else {
-                    format!("wheelset[{}].contact.{side}.force", k + 1)
-                };
-                self.jump = Some((d, name));
+                self.jump = Some((d, force_name(k, s)));
             }
         }
     }
@@ -156,11 +172,7 @@ impl ContactWatch {
         let speed = (position - last.position).abs() / span;
         let grid = 2.0 * speed * dt / radius;
         if off.abs() > RATE_TOLERANCE * rolled.abs() + grid + RATE_FLOOR * span {
-            let name = if k == 0 {
-                "wheel.rotation".to_string()
-            } else {
-                format!("wheelset[{}].wheel.rotation", k + 1)
-            };
+            let name = named(k, "wheel.rotation");
             self.rate = Some(format!(
                 "{name} turned by {} rad from t = {} s to {} s, but the track moved {} m \
                  there, which rolls the axle by {} rad (speed / wheel.radius): the flats \
@@ -189,7 +201,11 @@ impl ContactWatch {
     /// point, with the static load `load` (N): a wheel whose force has reversed its
     /// change by more than a tenth of the static load at each of the last
     /// [`CHATTER_RUN`] points chatters; its name, if any.
-    pub(super) fn forces_at_point(&mut self, forces: &[[f64; 2]], load: f64) -> Option<String> {
+    pub(super) fn forces_at_point(
+        &mut self,
+        forces: impl IntoIterator<Item = [f64; 2]>,
+        load: f64,
+    ) -> Option<String> {
         let mut chatter = None;
         for (k, (w, f)) in self.wheels.iter_mut().zip(forces).enumerate() {
             for s in 0..2 {
@@ -206,12 +222,7 @@ impl ContactWatch {
                 }
                 wheel.force = Some(f[s]);
                 if wheel.run >= CHATTER_RUN && chatter.is_none() {
-                    let side = if s == 0 { "left" } else { "right" };
-                    chatter = Some(if k == 0 {
-                        format!("contact.{side}.force")
-                    } else {
-                        format!("wheelset[{}].contact.{side}.force", k + 1)
-                    });
+                    chatter = Some(force_name(k, s));
                 }
             }
         }
@@ -238,7 +249,7 @@ mod tests {
         let mut seen = Vec::new();
         for n in 0..10 {
             let f = if n % 2 == 0 { 1.2e5 } else { 0.9e5 };
-            seen.push(w.forces_at_point(&[[f, load]], load).is_some());
+            seen.push(w.forces_at_point([[f, load]], load).is_some());
         }
         assert_eq!(
             seen,
@@ -250,7 +261,7 @@ mod tests {
         let mut w = ContactWatch::new(1);
         for n in 0..200 {
             let f = load + 2e5 * (std::f64::consts::TAU * n as f64 / 7.0).sin();
-            assert!(w.forces_at_point(&[[f, load]], load).is_none(), "{n}");
+            assert!(w.forces_at_point([[f, load]], load).is_none(), "{n}");
         }
     }
 
