@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Speed figures of the FMUs quoted in the README:
+"""Speed figures of the FMUs quoted in docs/guide/fmus.md ("Speed"):
 - fmpy.simulate_fmu on CoupledSystem for one simulated second (40 spans so that the
   wheel stays on the track; output interval 1 ms, max_force keeps the peak);
 - the fmpy FMU2Slave pair loop of python/couple.py, per communication step.

@@ -252,7 +252,7 @@ def test_recorded_wheel_heights_alone_drive_the_impact(paths):
     assert r["time"][k] == pytest.approx(ref["time"][k_ref], abs=0.3e-3)
     # The wheel motion sampled every 0.1 ms and replayed without the vehicle's answer:
     # within the first-order error of such a step (measured +9.7 %; the coupled pair
-    # at 0.1 ms gives +7.4 %, README).
+    # at 0.1 ms gives +7.4 %, docs/guide/couple-a-vehicle.md).
     assert r["contact.left.max_force"][-1] == pytest.approx(ref["contact.left.force"].max(), rel=0.12)
 
 
@@ -984,7 +984,7 @@ def test_input_derivatives_reduce_the_error_at_five_and_ten_times_the_step(paths
     # The pair at 5 and 10 times the track's step, the wheel inputs held or moved
     # along the vehicle's wheel velocities: the peak error against the track's own
     # step falls from +5.5 % to +0.7 % (5x) and from +12.2 % to +2.9 % (10x)
-    # (measured; README table).
+    # (measured; the table in docs/guide/couple-a-vehicle.md).
     def peak(mult, derivs):
         h = mult * wf.track_step(paths)
         out = wf.run_pair(paths, 0.3, h, input_derivatives=derivs)
