@@ -15,9 +15,13 @@ import sys
 import venv
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# In a checkout (python/ inside the repository) the FMUs are built with cargo into fmu/;
+# installed from the wheelflat wheel (python/pyproject.toml) they come with it.
+CHECKOUT = os.path.isfile(os.path.join(ROOT, "Cargo.toml"))
 VENV = os.path.join(ROOT, ".venv")
 REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
-FMU_DIR = os.path.join(ROOT, "fmu")
+FMU_DIR = os.path.join(ROOT, "fmu") if CHECKOUT else \
+    os.path.join(os.path.dirname(os.path.abspath(__file__)), "wheelflat_study", "_data", "fmu")
 FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")
 # Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
@@ -42,15 +46,19 @@ def install_venv():
 
 
 def ensure_venv():
-    """Re-runs the current script inside .venv (installed when needed)."""
-    if os.path.realpath(sys.prefix) == os.path.realpath(VENV):
+    """Re-runs the current script inside .venv (installed when needed); installed from
+    the wheel, the environment is the one it was installed into."""
+    if not CHECKOUT or os.path.realpath(sys.prefix) == os.path.realpath(VENV):
         return
     install_venv()
     os.execv(venv_python(), [venv_python()] + sys.argv)
 
 
 def build_fmus():
-    """Builds the shared library and packs fmu/*.fmu (cargo, release profile)."""
+    """Builds the shared library and packs fmu/*.fmu (cargo, release profile); the FMUs
+    by name. Installed from the wheel: the FMUs that came with it."""
+    if not CHECKOUT:
+        return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
     subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "build_fmus"], cwd=ROOT)
     subprocess.check_call([os.path.join(TARGET_DIR, "release", "build_fmus"), FMU_DIR], cwd=ROOT,
                           stdout=subprocess.DEVNULL)

@@ -9,10 +9,38 @@ step), one persistent runner per Dask worker. Results go to ``results.parquet`` 
 FMU GUID), ``impacts.parquet``/``.csv`` (one row per impact), and the plots the study
 asks for; a study started again skips the cases it already has.
 
-    python -m wheelflat_study studies/speed_flat.toml [--scheduler ADDRESS] [--workers N]
+    wheelflat-study studies/speed_flat.toml [--scheduler ADDRESS] [--workers N]
 
-See README.md ("Studies at scale") and docs/STUDIES.md.
+Installed from its wheel (``python/pyproject.toml``), the package carries its own case
+runner and the four FMUs (``fmu_paths()``), so a cluster's worker needs only the
+install. See docs/guide/studies.md and docs/STUDIES.md.
 """
+
+import json
+import os
 
 from .spec import Study, load_study  # noqa: F401
 from .run import run_study  # noqa: F401
+from .run import DATA, ROOT, default_runner, installed
+
+
+def fmu_paths():
+    """The four FMUs by name (TrackContact, RollPlaneVehicle, CoupledSystem,
+    HalfCarBogie): the installed package's, or in a checkout those in fmu/ (built by
+    ``cargo build --release && target/release/build_fmus fmu``)."""
+    from .buildinfo import FMUS
+    where = os.path.join(DATA, "fmu") if installed() else os.path.join(ROOT, "fmu")
+    return {name: os.path.join(where, name + ".fmu") for name in FMUS}
+
+
+def build_info():
+    """The versions and GUIDs of this installation's case runner and FMUs, and the git
+    commit it was built from (a dict; see :mod:`wheelflat_study.buildinfo`)."""
+    if installed():
+        with open(os.path.join(DATA, "build.json")) as fh:
+            return json.load(fh)
+    from .buildinfo import collect
+    runner = default_runner()
+    if runner is None:
+        raise RuntimeError("no case runner built in this checkout: cargo build --release")
+    return collect(runner, os.path.join(ROOT, "fmu"), ROOT)

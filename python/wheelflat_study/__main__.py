@@ -1,24 +1,27 @@
-"""python -m wheelflat_study STUDY.toml [--scheduler ADDRESS] [--workers N] [--serial]
-[--out DIR] [--chunk N] [--no-plots]
+"""wheelflat-study STUDY.toml [--scheduler ADDRESS] [--workers N] [--serial]
+[--out DIR] [--chunk N] [--case-time-limit S] [--no-plots]
+(in a checkout also: python -m wheelflat_study ...)
 
 Runs the study's cases on Dask (a local cluster of one process per core by default,
-or the dask.distributed scheduler at ADDRESS, whose workers must reach this checkout's
-case runner at the same path), writes results/<name>/results.parquet, .csv,
-impacts.parquet, .csv and the plots; started again, it runs only the missing cases.
+or the dask.distributed scheduler at ADDRESS, whose workers run the case runner of
+their own wheelflat install, which must be the same version), writes
+<out>/results.parquet, .csv, impacts.parquet, .csv and the plots (out: results/<name>
+in a checkout, else ./results/<name>); started again, it runs only the missing cases.
 """
 
 import argparse
+import json
 import os
 import sys
 
-from .run import ROOT, build_runner, run_study
+from .run import MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study
 from .spec import load_study
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m wheelflat_study", description=__doc__,
+    ap = argparse.ArgumentParser(prog="wheelflat-study", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("study", help="the study file (TOML), e.g. studies/speed_flat.toml")
+    ap.add_argument("study", nargs="?", help="the study file (TOML), e.g. studies/speed_flat.toml")
     ap.add_argument("--scheduler", help="address of a running dask.distributed scheduler")
     ap.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     ap.add_argument("--serial", action="store_true", help="no Dask: every case in this process, in order")
@@ -26,11 +29,35 @@ def main(argv=None):
     ap.add_argument("--chunk", type=int, help="cases per Dask task (default: a few per worker)")
     ap.add_argument("--no-plots", action="store_true")
     ap.add_argument("--no-progress", action="store_true")
-    ap.add_argument("--runner", help="the case runner (default: built here with cargo)")
+    ap.add_argument("--runner", help="the case runner, at this path for this process and every worker "
+                                     "(default: the installed package's, or in a checkout built with cargo)")
+    ap.add_argument("--case-time-limit", type=float, metavar="S",
+                    help=f"wall time one case may take (s); a case past it is stopped and recorded as "
+                         f"failed (default: {TIME_LIMIT_FACTOR:g} times its duration at the cost measured "
+                         f"at the start, at least {MIN_TIME_LIMIT:g} s)")
+    ap.add_argument("--version", action="store_true", help="print the installed versions and GUIDs, then stop")
     ap.add_argument("--retry-failed", action="store_true",
                     help="run again the cases that failed (those that failed for a passing reason, "
                          "a stopped runner or a lost worker, always run again)")
     args = ap.parse_args(argv)
+    # A batch system's SIGTERM stops the study as Ctrl-C does: the cases done are kept.
+    import signal
+
+    def stop(signum, frame):
+        raise KeyboardInterrupt
+    signal.signal(signal.SIGTERM, stop)
+    if args.version:
+        from . import build_info
+        print(json.dumps(build_info(), indent=1))
+        return 0
+    if args.study is None:
+        ap.print_usage(sys.stderr)
+        print("wheelflat-study: the study file is needed", file=sys.stderr)
+        return 2
+    limit = args.case_time_limit
+    if limit is not None and not (limit > 0 and limit < float("inf")):
+        print(f"--case-time-limit {limit:g}: a number of seconds above 0", file=sys.stderr)
+        return 2
     for flag, v in (("--chunk", args.chunk), ("--workers", args.workers)):
         if v is not None and v < 1:
             print(f"{flag} {v}: at least 1", file=sys.stderr)
@@ -40,23 +67,29 @@ def main(argv=None):
     except (OSError, ValueError) as e:
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
-    runner = args.runner or build_runner()
+    try:
+        runner = args.runner or build_runner()
+    except RuntimeError as e:
+        print(str(e), file=sys.stderr)
+        return 2
     if not (os.path.isfile(runner) and os.access(runner, os.X_OK)):
         print(f"--runner {runner}: not an executable file (the case runner, target/release/wheelflat_case)",
               file=sys.stderr)
         return 2
     try:
         check_variables(study, runner)
-        cases = study.cases()
+        study.check()
     except ValueError as e:
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
-    out = args.out or os.path.join(ROOT, "results", study.name)
+    out = args.out or os.path.join("results" if installed() else os.path.join(ROOT, "results"), study.name)
     try:
+        # Without --runner each worker runs its own install's runner (checked to be
+        # this one's version and GUID), so a cluster's hosts need no shared path.
         table, _ = run_study(study, out, scheduler=args.scheduler, workers=args.workers,
-                             serial=args.serial, chunk=args.chunk, runner_path=runner,
+                             serial=args.serial, chunk=args.chunk, runner_path=args.runner,
                              progress=not args.no_progress, plots=not args.no_plots,
-                             retry_failed=args.retry_failed)
+                             retry_failed=args.retry_failed, time_limit=limit)
     except KeyboardInterrupt:
         print("interrupted: the cases done so far are kept; run the same command to go on", file=sys.stderr)
         return 130
@@ -74,8 +107,8 @@ def main(argv=None):
     failed = int((table["status"] == "error").sum()) if len(table) else 0
     # A case with no result (its runner or worker lost) is a failure too: it runs the
     # next time the same command runs.
-    missing = len(cases) - len(table)
-    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {len(cases)} cases, "
+    missing = study.count() - len(table)
+    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {study.count()} cases, "
           f"{failed} failed" + (f", {missing} without a result: run the same command again to run them"
                                 if missing else "") + ")")
     failed += missing

@@ -3,104 +3,189 @@ existing scheduler), each worker with its own persistent case runner; results ke
 they come (``cases.jsonl``, so an interrupted study resumes), then the tables and plots.
 """
 
+import itertools
 import json
 import os
+import select
 import subprocess
 import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# The installed package's own case runner and FMUs (python/setup.py puts them there).
+DATA = os.path.join(HERE, "_data")
+INSTALLED_RUNNER = os.path.join(DATA, "bin", "wheelflat_case")
+# In a checkout: the repository and cargo's build of the runner.
 ROOT = os.path.dirname(os.path.dirname(HERE))
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
 RUNNER = os.path.join(TARGET_DIR, "release", "wheelflat_case")
 
+# The per-case time limit by default: this many times the case's simulated duration at
+# the cost per simulated second measured when the study starts (CoupledSystem's
+# defaults), and never below MIN_TIME_LIMIT. 200 covers a grid refined to n = 32 (16
+# times the default's cost) on four wheelsets with the machine 1.7 times slower.
+TIME_LIMIT_FACTOR = 200.0
+MIN_TIME_LIMIT = 60.0
+
+
+def installed():
+    """Whether this is the installed package (with its own runner), not a checkout."""
+    return os.path.isfile(INSTALLED_RUNNER)
+
+
+def default_runner():
+    """The case runner of this installation: the installed package's, else this
+    checkout's cargo build (None when neither is there)."""
+    for path in (INSTALLED_RUNNER, RUNNER):
+        if os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
+    return None
+
 
 def build_runner():
-    """Builds the case runner (cargo, release profile); its path."""
+    """The case runner: the installed package's, or in a checkout built with cargo
+    (release profile)."""
+    if installed():
+        return INSTALLED_RUNNER
+    if not os.path.isfile(os.path.join(ROOT, "Cargo.toml")):
+        raise RuntimeError("no case runner: install the package (docs/guide/studies.md) or give --runner")
     subprocess.check_call(["cargo", "build", "--release", "--quiet", "--bin", "wheelflat_case"], cwd=ROOT)
     return RUNNER
 
 
 class CaseRunner:
-    """One persistent ``wheelflat_case`` process: a case line in, a JSON line out."""
+    """One persistent ``wheelflat_case`` process: a case line in, a JSON line out.
+    Each request carries its case's id and each answer must carry it back; an answer
+    for another case, a runner that stops or a case past its time limit ends the
+    runner (the next case starts a new one)."""
 
     def __init__(self, path):
         self.path = path
         self.proc = None
+        self._buf = b""
 
     def _start(self):
         self.proc = subprocess.Popen([self.path], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                     stderr=subprocess.DEVNULL, text=True, bufsize=1)
+                                     stderr=subprocess.DEVNULL, bufsize=0)
+        self._buf = b""
 
-    def run(self, line):
+    def _stop(self):
+        """Ends the runner; how it ended, in words."""
+        proc, self.proc = self.proc, None
+        try:
+            code = proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            code = proc.wait()
+        return f"killed by signal {-code}" if code < 0 else f"exit status {code}"
+
+    def _kill(self):
+        if self.proc is not None:
+            self.proc.kill()
+            self._stop()
+
+    def _readline(self, deadline):
+        """The runner's next line (bytes, without the newline); b"" when it stopped;
+        None at the deadline (time.monotonic(); None waits as long as it takes)."""
+        fd = self.proc.stdout.fileno()
+        while b"\n" not in self._buf:
+            wait = None if deadline is None else max(0.0, deadline - time.monotonic())
+            ready, _, _ = select.select([fd], [], [], wait)
+            if not ready:
+                return None
+            more = os.read(fd, 1 << 16)
+            if not more:
+                return b""
+            self._buf += more
+        line, self._buf = self._buf.split(b"\n", 1)
+        return line
+
+    def run(self, line, case_id="case", limit=None):
+        """Runs one case: `line` (the runner's tokens), `case_id` (carried to the runner
+        and back), `limit` (s of wall time, None for none). The answer as a dict; a
+        failure of the runner as ``{"error": ..., "transient": True}`` (the case runs
+        again next time), a case past its limit as an error with ``time_limit``."""
         if self.proc is None or self.proc.poll() is not None:
             self._start()
+        t0 = time.monotonic()
         try:
-            self.proc.stdin.write(line + "\n")
+            self.proc.stdin.write(f"case={case_id} {line}\n".encode())
             self.proc.stdin.flush()
-            out = self.proc.stdout.readline()
+            out = self._readline(None if limit is None else t0 + limit)
         except (BrokenPipeError, OSError) as e:
-            out = ""
-            why = str(e)
+            out, why = b"", str(e)
         else:
             why = "no answer"
+        if out is None:
+            self._kill()
+            return {"error": f"the case ran past its time limit of {limit:.4g} s (the runner was stopped; "
+                             f"--case-time-limit sets the limit, --retry-failed runs it again)",
+                    "time_limit": limit}
         if not out:
-            try:
-                code = self.proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                code = self.proc.wait()
-            self.proc = None
-            how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
+            how = self._stop()
             return {"error": f"the case runner stopped ({why}, {how})", "transient": True}
-        return json.loads(out)
+        try:
+            res = json.loads(out)
+        except ValueError:
+            res = None
+        if not isinstance(res, dict) or res.get("case") != case_id:
+            # Never take an answer for another case (or none) as this one's.
+            got = res.get("case") if isinstance(res, dict) else out[:80].decode(errors="replace")
+            self._kill()
+            return {"error": f"the case runner answered {got!r} to case {case_id!r} (the runner was "
+                             f"restarted)", "transient": True}
+        del res["case"]
+        return res
 
 
 _RUNNERS = {}
 
 
 def _runner(path):
-    """The case runner of this process (one per Dask worker process)."""
+    """The case runner of this process (one per Dask worker process); `path` None:
+    this installation's own (on a cluster's worker: the worker's install)."""
+    path = path or default_runner()
+    if path is None:
+        raise RuntimeError("no case runner on this worker: install the wheelflat package there "
+                           "(docs/guide/studies.md)")
     r = _RUNNERS.get(path)
     if r is None:
         r = _RUNNERS[path] = CaseRunner(path)
     return r
 
 
-def run_chunk(chunk, runner_path):
-    """Runs the cases of `chunk` (a list of (case id, runner line)); a list of
-    (case id, result dict, wall seconds in this function)."""
+def run_chunk(chunk, runner_path=None):
+    """Runs the cases of `chunk` (a list of (case id, runner line, time limit s));
+    a list of (case id, result dict, wall seconds in this function)."""
     out = []
     r = _runner(runner_path)
-    for cid, line in chunk:
+    for cid, line, limit in chunk:
         t0 = time.perf_counter()
         try:
-            res = r.run(line)
+            res = r.run(line, cid, limit)
         except Exception as e:  # a failing case is recorded, the study goes on
             res = {"error": f"{type(e).__name__}: {e}", "transient": True}
         out.append((cid, res, time.perf_counter() - t0))
     return out
 
 
-def _chunks(items, size):
-    return [items[i:i + size] for i in range(0, len(items), size)]
+def warm_up(runner_path=None):
+    """Starts this process's runner; its (version, GUID) and cost per simulated second
+    of CoupledSystem's default case (s/s, measured on 0.2 s)."""
+    r = _runner(runner_path).run("duration=0.2", "warm-up")
+    if r.get("error"):
+        raise RuntimeError(f"the case runner {runner_path or default_runner()} fails: {r['error']}")
+    return (r.get("version"), r.get("guid")), r["wall_s"] / 0.2
 
 
-def identity(runner_path):
-    """The software version and CoupledSystem's GUID of the case runner at
-    `runner_path` (from its answer to a case it refuses)."""
-    r = subprocess.run([runner_path], input="duration=0\n", capture_output=True, text=True, timeout=60)
-    rec = json.loads(r.stdout.splitlines()[0])
-    return rec.get("version"), rec.get("guid")
-
-
-def load_done(out_dir, retry_failed=False, ident=None):
+def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
     """The results already in the study's folder, by case id. Lines that are not a
     whole record (cut by an interruption, or damaged) are skipped, so their cases run
     again; so do cases that failed for a passing reason (a stopped runner, a lost
     worker), with `retry_failed` every failed case, and, given `ident` (version, GUID),
     results of another software version or GUID (one table holds one model's
-    results); `load_done.other` counts those."""
+    results); `load_done.other` counts those. ids_only: the records' ids only (what a
+    start needs; a million records' parameters would not fit in the memory a start has)."""
     load_done.other = 0
     path = os.path.join(out_dir, "cases.jsonl")
     done = {}
@@ -123,7 +208,7 @@ def load_done(out_dir, retry_failed=False, ident=None):
                     done.pop(rec["id"], None)
                     load_done.other += 1
                     continue
-                done[rec["id"]] = rec
+                done[rec["id"]] = True if ids_only else rec
     return done
 
 
@@ -145,13 +230,17 @@ def _append(out_dir, records):
 
 
 def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=None,
-              runner_path=None, progress=True, plots=True, log=print, retry_failed=False):
+              runner_path=None, progress=True, plots=True, log=print, retry_failed=False, time_limit=None):
     """Runs the cases of `study` not yet in `out_dir` and writes the tables (and plots).
 
     scheduler: the address of a running dask.distributed scheduler; None starts a
     LocalCluster of `workers` processes (default: one per core). serial: no Dask, in
-    this process. Returns (the results table, the number of cases run now); the
-    times of the last run (start-up, the cases, the tables) are in `run_study.timing`."""
+    this process. runner_path: the case runner for this process and every worker
+    (None: each uses its own installation's, which must be the same version and GUID).
+    time_limit: the wall time a case may take (s); None: TIME_LIMIT_FACTOR times its
+    duration at the measured cost, at least MIN_TIME_LIMIT. Returns (the results table,
+    the number of cases run now); the times of the last run (start-up, the cases, the
+    tables) are in `run_study.timing`."""
     os.makedirs(out_dir, exist_ok=True)
     # One run per folder: a second one at the same time would compute every case again
     # and interleave the records.
@@ -163,45 +252,50 @@ def run_study(study, out_dir, scheduler=None, workers=None, serial=False, chunk=
             raise RuntimeError(f"another run is writing into {out_dir}: wait for it to end, or give "
                                f"another --out") from None
         return _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, progress, plots,
-                           log, retry_failed)
+                           log, retry_failed, time_limit)
 
 
 def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, progress, plots, log,
-                retry_failed):
-    """:func:`run_study` with the folder's lock held."""
-    runner_path = runner_path or RUNNER
-    cases = study.cases()
-    ids = [c.id for c in cases]
-    if len(set(ids)) != len(ids):
-        raise ValueError("the study has duplicate cases")
-    ident = identity(runner_path)
-    done = load_done(out_dir, retry_failed, ident)
+                retry_failed, time_limit):
+    """:func:`run_study` with the folder's lock held. The cases are made as they are
+    sent, so memory stays in proportion to the chunks in flight, not to the study."""
+    started = time.perf_counter()
+    study.check()
+    ident, cost = warm_up(runner_path or build_runner())
+    done = set(load_done(out_dir, retry_failed, ident, ids_only=True))
     if load_done.other:
         log(f"{study.name}: {load_done.other} results of another software version or model GUID in "
             f"{out_dir} are set aside and run again (this runner: version {ident[0]}, GUID {ident[1]})")
-    todo = [(c.id, c.line()) for c in cases if c.id not in done]
-    by_id = {c.id: c for c in cases}
-    log(f"{study.name}: {len(cases)} cases, {len(cases) - len(todo)} already done, {len(todo)} to run")
-    started = time.perf_counter()
-    ready = started
-    if todo:
+    total = study.count()
+    have = sum(1 for c in study.iter_cases() if c.id in done) if done else 0
+    log(f"{study.name}: {total} cases, {have} already done, {total - have} to run")
+    todo = (c for c in study.iter_cases() if c.id not in done)
+    if time_limit is None:
+        def limit(case):
+            return max(MIN_TIME_LIMIT, TIME_LIMIT_FACTOR * cost * case.duration)
+    else:
+        def limit(case):
+            return time_limit
+    ready = time.perf_counter()
+    if total > have:
         if serial:
-            ready = _serial(todo, by_id, out_dir, runner_path, progress)
+            _serial(todo, total - have, out_dir, runner_path, progress, limit)
         else:
-            ready = _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress)
+            ready = _dask(todo, total - have, out_dir, runner_path, scheduler, workers, chunk, progress, limit,
+                          ident)
     finished = time.perf_counter()
-    elapsed = finished - started
-    if todo:
-        log(f"ran {len(todo)} cases in {elapsed:.2f} s ({60 * len(todo) / elapsed:.0f} cases per minute)")
+    elapsed = finished - ready
+    if total > have:
+        log(f"ran {total - have} cases in {elapsed:.2f} s ({60 * (total - have) / elapsed:.0f} cases per minute)")
     from .tables import write_tables
-    table = write_tables(study, cases, load_done(out_dir, ident=ident), out_dir)
+    table = write_tables(study, study.iter_cases(), load_done(out_dir, ident=ident), out_dir)
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:
         from .plots import make_plots
         for p in make_plots(study, table, out_dir, log):
             log(f"wrote {p}")
-    return table, len(todo)
+    return table, total - have
 
 
 def _record(cid, res, wall, case):
@@ -216,22 +310,21 @@ def _bar(total, progress):
     return tqdm(total=total, unit="case", file=sys.stderr)
 
 
-def _serial(todo, by_id, out_dir, runner_path, progress):
-    """Runs the cases here; returns when the runner was ready (perf_counter)."""
-    _runner(runner_path).run("duration=1e-9")  # starts the runner
-    ready = time.perf_counter()
-    bar = _bar(len(todo), progress)
-    for cid, line in todo:
-        [(cid, res, wall)] = run_chunk([(cid, line)], runner_path)
-        _append(out_dir, [_record(cid, res, wall, by_id[cid])])
+def _serial(todo, count, out_dir, runner_path, progress, limit):
+    """Runs the `count` cases of the iterator `todo` here, in order."""
+    bar = _bar(count, progress)
+    for case in todo:
+        [(cid, res, wall)] = run_chunk([(case.id, case.line(), limit(case))], runner_path)
+        _append(out_dir, [_record(cid, res, wall, case)])
         if bar:
             bar.update(1)
     if bar:
         bar.close()
-    return ready
 
 
-def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress):
+def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress, limit, ident):
+    """Runs the `count` cases of the iterator `todo` on Dask, a few chunks per worker in
+    flight; returns when every worker's runner was ready (perf_counter)."""
     from dask.distributed import Client, LocalCluster, as_completed
     if scheduler:
         try:
@@ -244,31 +337,54 @@ def _dask(todo, by_id, out_dir, runner_path, scheduler, workers, chunk, progress
         except Exception:
             client.close()
             raise RuntimeError(f"the scheduler {scheduler} has no workers after 120 s: start some "
-                               f"(dask worker {scheduler}) with PYTHONPATH={os.path.join(ROOT, 'python')}")
+                               f"(dask worker {scheduler}, where the wheelflat package is installed)")
     else:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=":0")
         client = Client(cluster)
     try:
-        # Every worker's runner started: the cluster is ready.
-        client.run(lambda: _runner(runner_path).run("duration=1e-9") and None)
+        # Every worker's runner started, and the same model as this process's: one
+        # table holds one model's results.
+        try:
+            answers = client.run(warm_up, runner_path)
+        except Exception as e:
+            raise RuntimeError(f"a worker cannot start its case runner: {type(e).__name__}: {e}") from None
+        other = {w: tuple(i) for w, (i, _) in answers.items() if tuple(i) != tuple(ident)}
+        if other:
+            raise RuntimeError("workers with another version or model GUID than this one's (version "
+                               f"{ident[0]}, GUID {ident[1]}): "
+                               + ", ".join(f"{w}: version {v}, GUID {g}" for w, (v, g) in other.items()))
         ready = time.perf_counter()
-        nworkers = max(1, len(client.scheduler_info().get("workers", {})) or (workers or 1))
+        nworkers = max(1, len(answers))
         # Chunks of a few cases: the scheduler's cost per task is shared, and every
-        # worker still gets several chunks to balance the load.
-        size = chunk or max(1, min(8, len(todo) // (8 * nworkers)))
-        chunks = _chunks(todo, size)
-        futures = client.map(run_chunk, chunks, runner_path=runner_path, pure=False)
-        meta = {f.key: c for f, c in zip(futures, chunks)}
-        bar = _bar(len(todo), progress)
-        for fut in as_completed(futures):
+        # worker still gets several chunks to balance the load. Four chunks a worker in
+        # flight keep it busy; the rest are made when these come back.
+        size = chunk or max(1, min(8, count // (8 * nworkers)))
+        pending = as_completed()
+        flying = {}
+
+        def send():
+            cases = list(itertools.islice(todo, size))
+            if cases:
+                fut = client.submit(run_chunk, [(c.id, c.line(), limit(c)) for c in cases], runner_path,
+                                    pure=False)
+                flying[fut.key] = cases
+                pending.add(fut)
+
+        for _ in range(4 * nworkers):
+            send()
+        bar = _bar(count, progress)
+        for fut in pending:
+            cases = {c.id: c for c in flying.pop(fut.key)}
             try:
                 results = fut.result()
             except Exception as e:  # a lost worker or task: its cases run again next time
                 results = [(cid, {"error": f"{type(e).__name__}: {e}", "transient": True}, 0.0)
-                           for cid, _ in meta[fut.key]]
-            _append(out_dir, [_record(cid, res, wall, by_id[cid]) for cid, res, wall in results])
+                           for cid in cases]
+            fut.release()
+            _append(out_dir, [_record(cid, res, wall, cases[cid]) for cid, res, wall in results])
+            send()
             if bar:
                 bar.update(len(results))
         if bar:

@@ -9,10 +9,13 @@
 //!
 //! A case line holds `NAME=VALUE` tokens: CoupledSystem's parameters and inputs by name
 //! (docs/VARIABLES.md; enumerations by number), `duration=S` (s, required) and
-//! `keep=OUT1,OUT2` (outputs whose extremes to keep). The case runs through the FMU
+//! `keep=OUT1,OUT2` (outputs whose extremes to keep), and optionally `case=ID` (letters,
+//! digits, `_`, `.`, `-`; at most 64), the caller's name for the case, which the answer
+//! carries back so that no answer can be taken for another case's. The case runs through the FMU
 //! layer in this process (the same model, checks and refusals as CoupledSystem.fmu)
 //! and is sampled at every internal step. The JSON line has:
 //!
+//! * `case`: the request's `case=ID` (absent when the request had none);
 //! * `version`, `guid`: the software version and CoupledSystem's GUID;
 //! * `steps`, `step` (s), `wall_s`: the internal steps, their size and the wall time;
 //! * `peak`: the largest contact force of each wheel (`left`, `right`,
@@ -421,6 +424,33 @@ fn list_variables() {
     }
 }
 
+/// The request's `case=ID` token taken out of `line`: (the id, the rest of the line);
+/// an id that is not one is an error (the answer then carries no id).
+fn case_id(line: &str) -> (Result<Option<String>, String>, String) {
+    let mut id = Ok(None);
+    let mut rest = Vec::new();
+    for token in line.split_whitespace() {
+        match token.strip_prefix("case=") {
+            Some(v) if matches!(id, Ok(None)) => {
+                let good = !v.is_empty()
+                    && v.len() <= 64
+                    && v.bytes()
+                        .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b));
+                id = if good {
+                    Ok(Some(v.to_string()))
+                } else {
+                    Err(format!(
+                        "case = `{v}`: a case id is 1 to 64 letters, digits, '_', '.' or '-'"
+                    ))
+                };
+            }
+            Some(_) => id = Err("`case` is given twice in one case".into()),
+            None => rest.push(token),
+        }
+    }
+    (id, rest.join(" "))
+}
+
 fn main() {
     if std::env::args().nth(1).as_deref() == Some("--variables") {
         list_variables();
@@ -436,9 +466,11 @@ fn main() {
             Ok(_) => {}
         }
         // Every line gets one answer, a line that is not UTF-8 or holds no case too.
-        let line = String::from_utf8_lossy(&bytes).trim().to_string();
+        let (id, line) = case_id(String::from_utf8_lossy(&bytes).trim());
         // A panic in a case is reported as that case's error; the runner goes on.
-        let result = if line.is_empty() {
+        let result = if let Err(e) = &id {
+            Err(e.clone())
+        } else if line.is_empty() {
             Err("an empty case line: give NAME=VALUE tokens and duration=S".into())
         } else {
             std::panic::catch_unwind(|| parse(&line).and_then(|c| run(&c)))
@@ -452,6 +484,11 @@ fn main() {
                 json_str(Kind::CoupledSystem.table().guid),
                 json_str(&e)
             ),
+        };
+        // The answer names its case first: `{"case":"ID",...}`.
+        let text = match id {
+            Ok(Some(id)) => format!("{{\"case\":{},{}", json_str(&id), &text[1..]),
+            _ => text,
         };
         if writeln!(out, "{text}").and_then(|_| out.flush()).is_err() {
             break;
