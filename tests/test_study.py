@@ -1,6 +1,8 @@
-"""The sweep command (python -m wheelflat_study) on Dask: a local cluster against a
-serial run bit for bit, a scheduler and workers as separate processes on loopback,
-and an interrupted study resumed."""
+"""The sweep command (wheelflat-study, or python -m wheelflat_study in a checkout) on
+Dask: a local cluster against a serial run bit for bit, a scheduler and workers as
+separate processes on loopback (sharing this checkout's runner, and from the installed
+wheel alone), an interrupted study resumed, and the ways a study could lose, mix or
+invent a case (issue 26)."""
 
 import os
 import signal
@@ -347,3 +349,241 @@ def test_damaged_results_and_passing_failures_run_again(study, tmp_path, runner)
                          log=lambda *_: None)
     assert n == 3
     assert comparable(again).equals(comparable(whole))
+
+
+def test_every_answer_names_its_case_and_a_shifted_answer_lands_on_no_case(tmp_path, runner):
+    # Issue 26 item 3: a newline in `keep` desynchronised the runner's pipe, so each
+    # case received the previous line's answer (the 30 m/s row showed the 20 m/s
+    # result). Every request now carries its case's id, and the answer must carry it.
+    r = subprocess.run([runner], input="case=abc-1.x speed=20 duration=0.001\ncase=a/b duration=1\n"
+                                       "case=x case=y duration=1\n", capture_output=True, text=True, timeout=60)
+    import json
+    good, bad, twice = (json.loads(line) for line in r.stdout.splitlines())
+    assert good["case"] == "abc-1.x" and good["error"] is None and good["steps"] > 0
+    assert "case" not in bad and "case = `a/b`: a case id is 1 to 64 letters" in bad["error"]
+    assert "`case` is given twice" in twice["error"]
+    # A runner that answers each case with the previous case's answer (its first
+    # answer for a case nobody asked): no answer lands on a case it is not for.
+    shifted = tmp_path / "shifted_runner"
+    shifted.write_text(SHIFTED_RUNNER.format(python=sys.executable, runner=runner))
+    shifted.chmod(0o755)
+    p = tmp_path / "shift.toml"
+    p.write_text('name = "shift"\nduration = 0.05\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
+           "--no-progress", "--no-plots", "--runner"]
+    r = subprocess.run(cmd + [str(shifted)], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and "0 of 3 cases, 0 failed, 3 without a result" in r.stdout, (r.stdout, r.stderr)
+    records = [json.loads(line) for line in open(tmp_path / "o" / "cases.jsonl")]
+    assert len(records) == 3
+    for rec in records:
+        assert rec["result"]["transient"] and "peak" not in rec["result"]
+        assert f"the case runner answered 'nobody' to case '{rec['id']}'" in rec["result"]["error"], rec
+    import pandas as pd
+    # Those were passing failures: the real runner runs all three, each its own case.
+    r = subprocess.run(cmd + [runner], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "3 to run" in r.stdout, (r.stdout, r.stderr)
+    t = pd.read_csv(tmp_path / "o" / "results.csv")
+    for speed, peak in zip(t["speed"], t["peak.left"]):
+        alone = json.loads(subprocess.run([runner], input=f"speed={speed!r} duration=0.05\n", capture_output=True,
+                                          text=True, timeout=60).stdout)
+        assert alone["peak"]["left"] == peak
+
+
+SHIFTED_RUNNER = """#!{python}
+import json, subprocess, sys
+child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                         bufsize=1)
+if sys.argv[1:]:
+    sys.stdout.write(child.communicate()[0])
+    sys.exit(0)
+before = None
+for line in sys.stdin:
+    child.stdin.write(line)
+    child.stdin.flush()
+    answer = child.stdout.readline()
+    if line.startswith("case=warm-up"):
+        sys.stdout.write(answer)
+    else:
+        sys.stdout.write(before or json.dumps(dict(json.loads(answer), case="nobody")) + "\\n")
+        before = answer
+    sys.stdout.flush()
+"""
+
+STALLING_RUNNER = """#!{python}
+import subprocess, sys, time
+child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                         bufsize=1)
+if sys.argv[1:]:
+    sys.stdout.write(child.communicate()[0])
+    sys.exit(0)
+for line in sys.stdin:
+    if "speed=25.0" in line:
+        time.sleep(3600)   # a case that stalls
+    child.stdin.write(line)
+    child.stdin.flush()
+    sys.stdout.write(child.stdout.readline())
+    sys.stdout.flush()
+"""
+
+
+def test_a_case_past_its_time_limit_fails_alone_and_the_study_goes_on(tmp_path, runner, monkeypatch):
+    # Issue 26 item 13: one case could stall a study for hours.
+    stalling = tmp_path / "stalling_runner"
+    stalling.write_text(STALLING_RUNNER.format(python=sys.executable, runner=runner))
+    stalling.chmod(0o755)
+    p = tmp_path / "stall.toml"
+    p.write_text('name = "stall"\nduration = 0.02\n[sweep]\nspeed = [20.0, 25.0, 30.0]\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--out", str(tmp_path / "o"), "--no-progress",
+           "--no-plots", "--runner", str(stalling)]
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd + ["--serial", "--case-time-limit", "1.5"], env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert time.perf_counter() - t0 < 30
+    assert r.returncode == 1 and "3 of 3 cases, 1 failed" in r.stdout, (r.stdout, r.stderr)
+    import pandas as pd
+    t = pd.read_csv(tmp_path / "o" / "results.csv")
+    assert list(t["status"]) == ["ok", "error", "ok"]
+    assert "the case ran past its time limit of 1.5 s" in t["error"][1]
+    # Not a passing failure: the next run keeps it; --retry-failed runs it again.
+    r = subprocess.run(cmd + ["--serial", "--case-time-limit", "1.5"], env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert "0 to run" in r.stdout, r.stdout
+    r = subprocess.run(cmd[:-1] + [runner, "--serial", "--retry-failed"], env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0 and "1 to run" in r.stdout, (r.stdout, r.stderr)
+    # On Dask too, and with the default limit: FACTOR times the duration at the cost
+    # measured at the start, at least MIN_TIME_LIMIT (made small here).
+    import wheelflat_study.run as run
+    monkeypatch.setattr(run, "MIN_TIME_LIMIT", 2.0)
+    table, _ = run_study(load_study(p), str(tmp_path / "d"), workers=1, runner_path=str(stalling), progress=False,
+                         plots=False, log=lambda *_: None)
+    assert list(table["status"]) == ["ok", "error", "ok"]
+    assert "time limit of 2 s" in table["error"][1]
+
+
+MILLION = """
+name = "million"
+duration = 0.001
+[fixed]
+"track.window.ahead" = 8.0
+"track.window.behind" = 8.0
+[sweep]
+speed = { range = [10.0, 19.99, 0.01] }
+start_position = { range = [10.0, 10.999, 0.001] }
+"""
+
+
+@pytest.mark.parametrize("where", [["--serial"], ["--workers", "1"]])
+def test_a_million_case_study_starts_within_seconds_in_little_memory(tmp_path, runner, where):
+    # Issue 26 item 12: a 1e6-case study printed nothing for over 90 s and reached
+    # 935 MB before any case ran. The cases are now made as they are sent.
+    p = tmp_path / "million.toml"
+    p.write_text(MILLION)
+    out = tmp_path / "o"
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", "wheelflat_study", str(p), "--out", str(out), "--no-progress",
+                             "--no-plots", "--runner", runner] + where, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    records = out / "cases.jsonl"
+    while not (records.exists() and records.stat().st_size > 0) and time.perf_counter() - t0 < 60:
+        time.sleep(0.05)
+    first = time.perf_counter() - t0
+    time.sleep(2.0)  # a few thousand cases in
+    with open(f"/proc/{proc.pid}/status") as fh:
+        peak_kb = int(next(line for line in fh if line.startswith("VmHWM")).split()[1])
+    proc.send_signal(signal.SIGTERM)  # a batch system's stop: as Ctrl-C
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "interrupted: the cases done so far are kept" in stderr, (stdout, stderr)
+    assert "million: 1000000 cases, 0 already done, 1000000 to run" in stdout
+    # Measured: the first record after 0.2 s (serial) and 1.0 s (Dask, one worker); 19 and
+    # 81 MB at the peak.
+    assert first < 15, first
+    assert peak_kb < 250_000, peak_kb
+    assert len(load_done(str(out))) > 100
+
+
+def _installed_package(tmp_path):
+    """The wheelflat wheel built from this checkout and installed into a new virtual
+    environment; that environment's bin folder. The new environment reuses .venv's
+    installed dependencies (dask, pandas, ...) through a .pth file instead of
+    downloading them again; the package itself is installed by pip from the wheel."""
+    import sysconfig
+    wheels = tmp_path / "wheels"
+    subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w",
+                    str(wheels), os.path.join(ROOT, "python")], check=True, timeout=600)
+    [wheel] = list(wheels.glob("wheelflat-*-py3-none-linux_*.whl"))
+    env = tmp_path / "env"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(env)], check=True)
+    py = str(env / "bin" / "python")
+    site = subprocess.run([py, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    with open(os.path.join(site, "_venv_dependencies.pth"), "w") as fh:
+        fh.write(sysconfig.get_paths()["purelib"] + "\n")
+    subprocess.run([sys.executable, "-m", "pip", "--python", py, "install", "-q", "--no-deps", str(wheel)],
+                   check=True, timeout=300)
+    return env / "bin"
+
+
+def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout(study, tmp_path,
+                                                                                               runner):
+    # Issue 26, "On a real cluster": the workers needed the checkout's runner at the
+    # client's path. Here the scheduler, two workers and the study command run as
+    # separate processes, each in its own empty folder, with only the installed
+    # package: no checkout on the path, no PYTHONPATH, no --runner.
+    bin_dir = _installed_package(tmp_path)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "CARGO_TARGET_DIR")}
+    py = str(bin_dir / "python")
+    folders = {name: tmp_path / name for name in ("scheduler", "worker1", "worker2", "client")}
+    for f in folders.values():
+        f.mkdir()
+    where = subprocess.run([py, "-c", "import wheelflat_study.run as r, wheelflat_fmus as f; "
+                                      "print(r.default_runner()); print(f.FMU_DIR)"],
+                           cwd=folders["client"], env=env, capture_output=True, text=True, check=True).stdout.split()
+    assert all(w.startswith(str(tmp_path / "env")) for w in where), where
+    import json
+    info = json.loads(subprocess.run([str(bin_dir / "wheelflat-study"), "--version"], cwd=folders["client"], env=env,
+                                     capture_output=True, text=True, check=True).stdout)
+    import zipfile
+    with zipfile.ZipFile(os.path.join(ROOT, "fmu", "CoupledSystem.fmu")) as z:
+        md = z.read("modelDescription.xml").decode()
+    assert f'guid="{info["fmus"]["CoupledSystem"]["guid"]}"' in md
+    assert info["runner"]["guid"] == info["fmus"]["CoupledSystem"]["guid"]
+    assert set(info["fmus"]) == {"TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"}
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    procs = [subprocess.Popen([py, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                               "--no-dashboard"], cwd=folders["scheduler"], env=env, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)]
+    try:
+        time.sleep(2.0)
+        for k in (1, 2):
+            procs.append(subprocess.Popen([py, "-m", "distributed.cli.dask_worker", addr, "--nworkers", "1",
+                                           "--nthreads", "1", "--no-dashboard", "--name", f"w{k}"],
+                                          cwd=folders[f"worker{k}"], env=env, stdout=subprocess.DEVNULL,
+                                          stderr=subprocess.DEVNULL))
+        from dask.distributed import Client
+        with Client(addr, timeout=30) as c:
+            c.wait_for_workers(2, timeout=60)
+        (folders["client"] / "small.toml").write_text(study.read_text())
+        r = subprocess.run([str(bin_dir / "wheelflat-study"), "small.toml", "--scheduler", addr, "--no-progress",
+                            "--no-plots", "--chunk", "1"], cwd=folders["client"], env=env, capture_output=True,
+                           text=True, timeout=300)
+        assert r.returncode == 0, (r.stdout, r.stderr)
+        assert "results/small/results.parquet" in r.stdout
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+    import pandas as pd
+    remote = pd.read_parquet(folders["client"] / "results" / "small" / "results.parquet")
+    serial, _ = run_study(load_study(study), str(tmp_path / "serial"), serial=True, runner_path=runner,
+                          progress=False, plots=False, log=lambda *_: None)
+    assert len(remote) == 8 and (remote["status"] == "ok").all()
+    assert comparable(remote).equals(comparable(serial))
