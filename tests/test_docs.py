@@ -69,6 +69,27 @@ MAPPED = {
         ["wf.run_axle_box_pair("],
         "pseudo-code for a third-party bogie model; run_axle_box_pair is that loop with "
         "RollPlaneVehicle as the bogie, which the test runs at 1 and 2 ms"),
+    ".venv/bin/python -m pip wheel --no-deps --no-build-isolation -w dist python/": (
+        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        ['"pip", "wheel"', '"--no-deps", "--no-build-isolation"', 'os.path.join(ROOT, "python")'],
+        "builds the wheel; the test builds it into a temporary folder, not the checkout's dist/"),
+    "pip install dist/wheelflat-0.1.0-py3-none-linux_x86_64.whl": (
+        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        ['"pip", "--python", py, "install"', "wheelflat-*-py3-none-linux_*.whl"],
+        "installs on a cluster's host; the test installs into a new environment, not this .venv"),
+    "python -m distributed.cli.dask_scheduler --host 127.0.0.1 --port 8786 --no-dashboard &": (
+        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        ['"distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port"', '"--no-dashboard"'],
+        "a scheduler that runs until stopped; the test starts it on a free port in an empty folder"),
+    "python -m distributed.cli.dask_worker tcp://127.0.0.1:8786 --nworkers 1 --nthreads 1 --no-dashboard &": (
+        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        ['"distributed.cli.dask_worker", addr, "--nworkers", "1"', '"--nthreads", "1", "--no-dashboard"'],
+        "a worker that runs until stopped; the test starts two, each in its own empty folder"),
+    "wheelflat-study speed_flat.toml --scheduler tcp://127.0.0.1:8786": (
+        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        ['"wheelflat-study"', '"--scheduler", addr'],
+        "needs the scheduler and workers above; the test runs it from an empty folder with only the "
+        "installed wheel and compares the table with a serial run bit for bit"),
 }
 # A command that needs another to have run first: the study's tables are read after the
 # study has run.

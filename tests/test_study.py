@@ -505,11 +505,15 @@ def test_a_million_case_study_starts_within_seconds_in_little_memory(tmp_path, r
     assert len(load_done(str(out))) > 100
 
 
-def _installed_package(tmp_path):
-    """The wheelflat wheel built from this checkout and installed into a new virtual
-    environment; that environment's bin folder. The new environment reuses .venv's
-    installed dependencies (dask, pandas, ...) through a .pth file instead of
-    downloading them again; the package itself is installed by pip from the wheel."""
+def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout(study, tmp_path,
+                                                                                               runner):
+    # Issue 26, "On a real cluster": the workers needed the checkout's runner at the
+    # client's path. Here the scheduler, two workers and the study command run as
+    # separate processes, each in its own empty folder, with only the installed
+    # package: no checkout on the path, no PYTHONPATH, no --runner.
+    # The wheel, built from this checkout, installed by pip into a new environment,
+    # which reuses .venv's installed dependencies (dask, pandas, ...) through a .pth
+    # file instead of downloading them again.
     import sysconfig
     wheels = tmp_path / "wheels"
     subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation", "-w",
@@ -524,16 +528,7 @@ def _installed_package(tmp_path):
         fh.write(sysconfig.get_paths()["purelib"] + "\n")
     subprocess.run([sys.executable, "-m", "pip", "--python", py, "install", "-q", "--no-deps", str(wheel)],
                    check=True, timeout=300)
-    return env / "bin"
-
-
-def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout(study, tmp_path,
-                                                                                               runner):
-    # Issue 26, "On a real cluster": the workers needed the checkout's runner at the
-    # client's path. Here the scheduler, two workers and the study command run as
-    # separate processes, each in its own empty folder, with only the installed
-    # package: no checkout on the path, no PYTHONPATH, no --runner.
-    bin_dir = _installed_package(tmp_path)
+    bin_dir = env / "bin"
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "CARGO_TARGET_DIR")}
     py = str(bin_dir / "python")
     folders = {name: tmp_path / name for name in ("scheduler", "worker1", "worker2", "client")}
