@@ -5,10 +5,16 @@
 //! bits of every field of every sample (time, position, rotation, wheel and rail
 //! displacements, every field of both contact states).
 //!
-//! `cargo run --release --example sample_hash [seed|defaults|flats]` (all three
+//! Each run twice: with the rail between nodes as a beam (the default since issue 27)
+//! and as the thesis' linear interpolation (3.23) (`-linear`), which gives the bits
+//! every run gave before issue 27 (ca87e4a538843d11, fd1aed06ca0dd1f1,
+//! e173932efd4e3ca6).
+//!
+//! `cargo run --release --example sample_hash [seed|defaults|flats][-linear]` (all six
 //! without an argument; one of them for counting its instructions under callgrind).
 
 use wheelflat::sim::{Sample, Scenario, Simulation};
+use wheelflat::track::RailBetweenNodes;
 use wheelflat::wheel::FlatSpec;
 
 /// FNV-1a over the bits of `f64`s.
@@ -60,6 +66,12 @@ fn main() {
     let run = |key: &str, name: &str, s: &Scenario, duration: f64| {
         if only.as_deref().is_none_or(|o| o == key) {
             run(name, s, duration);
+        }
+        let key = format!("{key}-linear");
+        if only.as_deref().is_none_or(|o| o == key) {
+            let mut linear = s.clone();
+            linear.set_between_nodes(RailBetweenNodes::Linear);
+            run(&format!("{name}, linear (3.23)"), &linear, duration);
         }
     };
     let mut seed = Scenario::table_4_4_flat();

@@ -139,6 +139,63 @@ impl ContactLaw {
         }
     }
 
+    /// The contact state with a compliance `compliance` `c` (m/N) in series on the
+    /// rail's side (the rail under a load between nodes, `Track::shear_compliance`):
+    /// the force `P` that solves `P = P_law(overlap - c P)`, and the law's state at the
+    /// overlap `overlap - c P` that carries it (its `overlap` field). `g(P) = P -
+    /// P_law(overlap - c P)` rises with slope `1 + c k >= 1` (`k` the law's stiffness),
+    /// so the root is unique, in `[0, P_law(overlap)]`; Newton's method from `guess`
+    /// (N; the force of the step before) finds it, typically in one step: it stops once
+    /// `|g| <= 1e-9 |P| + 1e-6 N` (at most 30 steps; a step that leaves the bracket
+    /// is bisected). `compliance <= 0` is [`ContactLaw::evaluate_into`] itself, bit for
+    /// bit. Returns the force used for the rail's deflection, `P` (N): `c P` is how far
+    /// the rail under the wheel lies below the nodes' [`crate::track::Track::rail_z_at`].
+    #[inline(always)]
+    pub(crate) fn evaluate_in_series_into(
+        &self,
+        wheel: &WheelProfile,
+        gamma: f64,
+        overlap: f64,
+        compliance: f64,
+        guess: f64,
+        out: &mut ContactState,
+    ) -> f64 {
+        if compliance.is_nan() || compliance <= 0.0 {
+            self.evaluate_into(wheel, gamma, overlap, out);
+            return out.force;
+        }
+        let (mut lo, mut hi) = (0.0, f64::INFINITY);
+        let mut p = if guess.is_finite() {
+            guess.max(0.0)
+        } else {
+            0.0
+        };
+        for _ in 0..30 {
+            let d = overlap - compliance * p;
+            self.evaluate_into(wheel, gamma, d, out);
+            let g = p - out.force;
+            if g.abs() <= 1e-9 * p.abs() + 1e-6 || !g.is_finite() {
+                return p;
+            }
+            if g > 0.0 {
+                hi = p;
+            } else {
+                lo = p;
+            }
+            let k = self.stiffness_at(wheel, gamma, d);
+            let next = p - g / (1.0 + compliance * k);
+            p = if next > lo && next < hi {
+                next
+            } else if hi.is_finite() {
+                0.5 * (lo + hi)
+            } else {
+                out.force
+            };
+        }
+        self.evaluate_into(wheel, gamma, overlap - compliance * p, out);
+        p
+    }
+
     /// Overlap (m) at which this law carries `force` (N) for the wheel at axle
     /// rotation `gamma` (rad): the inverse of [`ContactLaw::evaluate`], by bisection to
     /// 1e-16 relative; 0 for `force <= 0`.

@@ -10,7 +10,7 @@
 //!   (it implies C_H ~ 1.0e10 N/m^1.5); the printed value is kept.
 
 use crate::contact::ContactModel;
-use crate::track::{RailEnds, RailSection, TrackParams};
+use crate::track::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 use crate::vehicle::{
     HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
 };
@@ -170,6 +170,7 @@ fn table_4_track(spans: usize) -> TrackParams {
         sleeper_mass: 270.0,
         sleeper_inertia: 90.0,
         ends: RailEnds::Fixed,
+        between_nodes: RailBetweenNodes::Beam,
     }
 }
 
@@ -253,6 +254,7 @@ impl Scenario {
                 sleeper_mass: 180.0,
                 sleeper_inertia: 90.0,
                 ends: RailEnds::Fixed,
+                between_nodes: RailBetweenNodes::Beam,
             }),
             vehicle: VehicleSpec::RollPlane(RollPlaneParams {
                 carbody_mass: 14702.0,
@@ -306,6 +308,7 @@ impl Scenario {
             sleeper_mass: 250.0,
             sleeper_inertia: 90.0,
             ends: RailEnds::Fixed,
+            between_nodes: RailBetweenNodes::Beam,
         });
         s.vehicle = VehicleSpec::RollPlane(RollPlaneParams {
             carbody_mass: 22135.0,
@@ -404,6 +407,14 @@ impl Scenario {
     pub fn set_nodes_per_span(&mut self, n: usize) {
         if let TrackSpec::Discrete(t) = &mut self.track {
             t.nodes_per_span = n;
+        }
+    }
+
+    /// Sets how a discrete track's rail is taken under a wheel between grid nodes
+    /// ([`RailBetweenNodes::Linear`] is the thesis' (3.23)).
+    pub fn set_between_nodes(&mut self, b: RailBetweenNodes) {
+        if let TrackSpec::Discrete(t) = &mut self.track {
+            t.between_nodes = b;
         }
     }
 

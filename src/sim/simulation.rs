@@ -876,10 +876,36 @@ impl Simulation {
 
     #[inline(always)]
     fn compute_sample(&self, w: &Wheelset) -> Sample {
-        let mut s = Sample::default();
+        // The step before's contact forces start the contact's solve, as in `step`
+        // (the same bits whether a master reads the outputs before stepping or not).
+        let mut s = Sample {
+            contact: w.latest().contact,
+            ..Sample::default()
+        };
         (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = self.sample_head(w);
-        contact_states(&w.vehicle, &self.law, w.wheels(), &mut s);
+        let compliance = self.compliance_under(s.position - self.origin);
+        contact_states(&w.vehicle, &self.law, w.wheels(), compliance, &mut s);
         s
+    }
+
+    /// The rail's local compliance (m/N) under wheels at track position `x` (m):
+    /// [`crate::track::Track::shear_compliance`]; 0 on the lumped track.
+    #[inline(always)]
+    fn compliance_under(&self, x: f64) -> f64 {
+        match &self.track {
+            TrackState::Discrete(t) => t.shear_compliance(x),
+            TrackState::Lumped(_) => 0.0,
+        }
+    }
+
+    /// The rail's local compliance (m/N) under wheelset `k` (0 the leading one) now, in
+    /// series with its contacts ([`crate::track::Track::shear_compliance`]); 0 on the
+    /// lumped track and for a wheelset the simulation does not have.
+    pub fn contact_compliance_of(&self, k: usize) -> f64 {
+        match self.wheelsets.get(k) {
+            Some(w) => self.compliance_under(w.position(self.position()) - self.origin),
+            None => 0.0,
+        }
     }
 
     /// Everything of wheelset `w`'s sample at the current time but the contact states:
@@ -965,9 +991,10 @@ impl Simulation {
             self.wheelsets.lead_mut().latest = s;
         } else {
             let head = self.sample_head(self.lead());
+            let compliance = self.compliance_under(head.1 - self.origin);
             let (wheels, vehicle, s) = self.wheelsets.lead_mut().parts_mut();
             (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
-            contact_states(vehicle, &self.law, wheels, s);
+            contact_states(vehicle, &self.law, wheels, compliance, s);
         }
         if !displacements_within(&self.lead().latest) {
             return Err(self.displacement_diverged(self.lead()));

@@ -33,6 +33,7 @@ impl Simulation {
         let mut v = vec![c.dt, c.t0, c.k as f64, self.steps as f64];
         for w in self.wheelsets.iter() {
             v.extend(w.extremes.to_array());
+            v.extend(w.latest().contact.map(|c| c.force));
         }
         for site in &self.sites {
             v.extend(site.extremes());
@@ -110,7 +111,8 @@ impl Simulation {
         };
         let nv = Self::vehicle_state(&self.wheelsets.lead().vehicle)?.len();
         let nw = self.wheelsets.len();
-        let extremes_end = CLOCK + ForceExtremes::LEN * self.wheelsets.len();
+        let per_wheelset = ForceExtremes::LEN + 2;
+        let extremes_end = CLOCK + per_wheelset * self.wheelsets.len();
         let head = extremes_end + Site::STATE_LEN * self.sites.len();
         let nb = self.bogie.as_ref().map_or(0, |b| b.state_vector().len());
         let total = head + nt + nw * nv + Motion::LEN + 1 + nb;
@@ -119,6 +121,17 @@ impl Simulation {
                 "simulation state length",
                 v.len() as f64,
                 format!("{total} values for this scenario"),
+            ));
+        }
+        let forces = v[CLOCK..extremes_end].chunks_exact(per_wheelset);
+        if let Some(&x) = forces
+            .flat_map(|x| &x[ForceExtremes::LEN..])
+            .find(|x| !x.is_finite())
+        {
+            return Err(out_of_range(
+                "state: contact force of the step before",
+                x,
+                "finite",
             ));
         }
         let tail = &v[total - nb - Motion::LEN - 1..total - nb];
@@ -171,9 +184,12 @@ impl Simulation {
         let c = &mut self.clock;
         (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);
         self.steps = v[3] as u64;
-        let extremes = v[CLOCK..extremes_end].chunks_exact(ForceExtremes::LEN);
+        let extremes = v[CLOCK..extremes_end].chunks_exact(per_wheelset);
         for (w, x) in self.wheelsets.iter_mut().zip(extremes) {
-            w.extremes = ForceExtremes::from_slice(x);
+            w.extremes = ForceExtremes::from_slice(&x[..ForceExtremes::LEN]);
+            for (c, &f) in w.latest.contact.iter_mut().zip(&x[ForceExtremes::LEN..]) {
+                c.force = f;
+            }
         }
         if let TrackState::Discrete(t) = &self.track {
             let stored = v[extremes_end..head].chunks_exact(Site::STATE_LEN);

@@ -99,8 +99,13 @@ impl Simulation {
         for k in 0..self.wheelsets.len() {
             let w = self.wheelsets.get(k).expect("k < len");
             let xw = w.position(x);
+            // The rail under each wheel: the nodes' deflection there, lowered by the
+            // static load through the rail's local compliance between nodes.
             let zr = match &self.track {
-                TrackState::Discrete(t) => [t.rail_z_at(0, xw), t.rail_z_at(1, xw)],
+                TrackState::Discrete(t) => {
+                    let c = t.shear_compliance(xw);
+                    [t.rail_z_at(0, xw) - c * p[0], t.rail_z_at(1, xw) - c * p[1]]
+                }
                 TrackState::Lumped(t) => t.rail_z(),
             };
             let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));

@@ -328,9 +328,10 @@ fn a_site_records_what_the_track_feels_as_the_wheel_passes() {
     t.set_static(&loads).unwrap();
     let still = t.support_response(0, site).rail_seat_force;
     let passing = sim.sites()[0].max()[0][3];
-    // 45.02 kN passing against 44.25 kN standing: 1.8 % dynamic at 70 km/h.
+    // Quasi-static at 70 km/h: 44.22 kN passing against 44.25 kN standing (45.02 kN
+    // with the rail between nodes by (3.23), whose node-passing ripple added 1.8 %).
     assert!(
-        (0.0..0.03).contains(&(passing / still - 1.0)),
+        (passing / still - 1.0).abs() < 0.005,
         "{passing} against {still}"
     );
 }

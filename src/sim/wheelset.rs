@@ -225,29 +225,45 @@ pub(crate) fn wheel_loads(
 /// `vehicle`, whose head
 /// (time, rotation, wheel and rail displacements) is set, written in place: the
 /// contact law at the overlaps `z_rail - z_wheel` (2.7) with the axle at the sample's
-/// rotation, or the constant loads.
+/// rotation, or the constant loads. `compliance` (m/N): the rail's local compliance
+/// under the wheels ([`crate::track::Track::shear_compliance`]; 0 on a node and on the
+/// lumped track), in series with the contact; the sample's rail displacements end as
+/// those under the loads (lowered by `compliance` times the force). The contact
+/// forces `s` holds on entry (the step before's) start the solve.
 #[inline(always)]
 pub(crate) fn contact_states(
     vehicle: &VehicleState,
     law: &ContactLaw,
     wheels: &[WheelProfile; 2],
+    compliance: f64,
     s: &mut Sample,
 ) {
     match vehicle {
         VehicleState::ConstantLoad(p) => {
-            for (c, &force) in s.contact.iter_mut().zip(p) {
+            for (i, (c, &force)) in s.contact.iter_mut().zip(p).enumerate() {
                 *c = ContactState {
                     force,
                     intervals: 1,
                     ..Default::default()
                 };
+                s.rail_z[i] -= compliance * force;
             }
         }
         _ => {
             let gamma = wrap_turns(s.rotation);
             for i in 0..2 {
                 let overlap = s.rail_z[i] - s.wheel_z[i];
-                law.evaluate_into(&wheels[i], gamma, overlap, &mut s.contact[i]);
+                // The force of the step before (what `s` holds) starts the solve.
+                let guess = s.contact[i].force;
+                let p = law.evaluate_in_series_into(
+                    &wheels[i],
+                    gamma,
+                    overlap,
+                    compliance,
+                    guess,
+                    &mut s.contact[i],
+                );
+                s.rail_z[i] -= compliance * p;
             }
         }
     }

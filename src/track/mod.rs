@@ -30,7 +30,7 @@ mod window;
 
 pub use crate::numerics::SimdLevel;
 pub use observe::{RailResponse, SupportResponse};
-pub use params::{RailEnds, RailSection, TrackParams};
+pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
 pub use stepper::{PointLoad, Track};
 

@@ -61,6 +61,21 @@ pub enum RailEnds {
     Pinned,
 }
 
+/// The rail under a wheel between two grid nodes (`docs/MODEL.md`, "The rail between
+/// nodes").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RailBetweenNodes {
+    /// The Timoshenko rail's shape between the nodes: (3.23)'s interpolation with the
+    /// bending sag of the element's curvature, and the shear kink under the wheel's
+    /// load in series with the contact ([`super::Track::shear_compliance`]).
+    #[default]
+    Beam,
+    /// The thesis' linear interpolation of the two nodes (3.23), and (3.22) alone:
+    /// the rail between nodes is too stiff by up to `dx / (4 kAG)`, a numerical
+    /// roughness with the node spacing as its wavelength.
+    Linear,
+}
+
 /// Track parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackParams {
@@ -88,6 +103,8 @@ pub struct TrackParams {
     pub sleeper_inertia: f64,
     /// Rail end conditions.
     pub ends: RailEnds,
+    /// The rail under a wheel between grid nodes.
+    pub between_nodes: RailBetweenNodes,
 }
 
 impl TrackParams {

@@ -49,6 +49,12 @@ pub struct Track {
     pub(super) dt_critical: f64,
     /// `1 / dx` (1/m), for locating loads.
     pub(super) inv_dx: f64,
+    /// `dx / kAG` (m/N), for [`Track::shear_compliance`]; 0 with
+    /// [`RailBetweenNodes::Linear`].
+    pub(super) shear_dx_per_kag: f64,
+    /// `dx / 2` (m), the bending sag's factor in [`Track::rail_z_at`]; 0 with
+    /// [`RailBetweenNodes::Linear`].
+    pub(super) sag_dx: f64,
     /// Nodes per rail `K + 1`.
     pub(super) nk: usize,
     /// Sleepers `N_s = N + 1`.
@@ -148,6 +154,14 @@ impl Track {
             dt,
             dt_critical: f64::NAN,
             inv_dx: 1.0 / params.dx(),
+            shear_dx_per_kag: match params.between_nodes {
+                RailBetweenNodes::Beam => params.dx() / params.rail.kag,
+                RailBetweenNodes::Linear => 0.0,
+            },
+            sag_dx: match params.between_nodes {
+                RailBetweenNodes::Beam => 0.5 * params.dx(),
+                RailBetweenNodes::Linear => 0.0,
+            },
             nk,
             ns,
             sp,
@@ -291,24 +305,47 @@ impl Track {
         locate(x, self.inv_dx, self.nk)
     }
 
-    /// Rail deflection (m) under position `x` on `rail`, interpolated by (3.23).
+    /// Rail deflection (m) under position `x` on `rail`: (3.23)'s interpolation of the
+    /// two nodes around `x` with the bending sag between them,
+    /// `(1 - w) Z_k + w Z_(k+1) - (theta_(k+1) - theta_k) dx w (1 - w) / 2` (the
+    /// element's curvature `(theta_(k+1) - theta_k) / dx` over its chord; 0 on a node);
+    /// (3.23) alone with [`RailBetweenNodes::Linear`].
+    /// A load at `x` deflects the rail there further by [`Track::shear_compliance`]
+    /// times the load (`docs/MODEL.md`, "The rail between nodes").
     #[inline]
     pub fn rail_z_at(&self, rail: usize, x: f64) -> f64 {
         let (k, w) = self.locate(x);
-        (1.0 - w) * self.z[self.slot_of(rail, k)] + w * self.z[self.slot_of(rail, k + 1)]
+        let (a, b) = (self.slot_of(rail, k), self.slot_of(rail, k + 1));
+        let sag = self.sag_dx * w * (1.0 - w);
+        (1.0 - w) * self.z[a] + w * self.z[b] - (self.th[b] - self.th[a]) * sag
     }
 
-    /// Rail deflections (m) under position `x` on the left and right rail, (3.23):
-    /// [`Track::rail_z_at`] of both rails, located once.
+    /// [`Track::rail_z_at`] of the left and right rail at `x`, located once.
     #[inline(always)]
     pub fn rail_z_pair(&self, x: f64) -> [f64; 2] {
         let (k, w) = self.locate(x);
         let (s0, s1) = (self.slot[k], self.slot[k + 1]);
         let sp = self.sp;
+        let sag = self.sag_dx * w * (1.0 - w);
         [
-            (1.0 - w) * self.z[s0] + w * self.z[s1],
-            (1.0 - w) * self.z[s0 + sp] + w * self.z[s1 + sp],
+            (1.0 - w) * self.z[s0] + w * self.z[s1] - (self.th[s1] - self.th[s0]) * sag,
+            (1.0 - w) * self.z[s0 + sp] + w * self.z[s1 + sp]
+                - (self.th[s1 + sp] - self.th[s0 + sp]) * sag,
         ]
+    }
+
+    /// The rail's local compliance under a point load at `x` (m/N): a Timoshenko
+    /// rail's slope jumps by `F / kAG` under a point load `F`, a kink that nodal values
+    /// represent only when the load sits on a node; between nodes, at `w` of the way
+    /// from node `k`, the rail under the load lies `F dx w (1 - w) / kAG` below what the
+    /// nodes give (the kink's tent over the element, split `(1 - w, w)` as the load is
+    /// by (3.22)). 0 on a node; at most `dx / (4 kAG)` mid-element (8.9e-11 m/N at
+    /// n = 8 on table 4.4's rail, against 6.9e-10 m/N for the contact at the static
+    /// load). The contact solves its force with it in series (`docs/MODEL.md`).
+    #[inline(always)]
+    pub fn shear_compliance(&self, x: f64) -> f64 {
+        let (_, w) = self.locate(x);
+        self.shear_dx_per_kag * w * (1.0 - w)
     }
 
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.

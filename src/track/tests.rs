@@ -15,6 +15,7 @@ fn seed_track(spans: usize, n: usize) -> TrackParams {
         sleeper_mass: 270.0,
         sleeper_inertia: 90.0,
         ends: RailEnds::Fixed,
+        between_nodes: RailBetweenNodes::Beam,
     }
 }
 

@@ -8,7 +8,7 @@ use crate::fmu::vars::{
 };
 use crate::sim::VehicleUnitParams;
 use crate::sim::{Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
-use crate::track::{RailEnds, RailSection, TrackParams};
+use crate::track::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 use crate::vehicle::{HalfCarParams, RollPlaneParams};
 use crate::wheel::{FlatShape, FlatSpec};
 
@@ -33,6 +33,12 @@ pub fn track_params(v: &[f64]) -> TrackParams {
         sleeper_mass: v(vr::TRACK_SLEEPER_MASS),
         sleeper_inertia: v(vr::TRACK_SLEEPER_INERTIA),
         ends: RailEnds::Fixed,
+        // The table's range holds the enumeration to its items (checked at set).
+        between_nodes: if v(vr::TRACK_RAIL_BETWEEN_NODES) == enums::rail_between_nodes::LINEAR {
+            RailBetweenNodes::Linear
+        } else {
+            RailBetweenNodes::Beam
+        },
     }
 }
 
