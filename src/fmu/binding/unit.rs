@@ -180,7 +180,8 @@ fn contact_output(r: u32) -> Option<(usize, usize, crate::fmu::vars::Quantity)> 
         | Quantity::ContactRearAngle
         | Quantity::ContactLength
         | Quantity::ContactMaxForce
-        | Quantity::ContactMinForce => Some((k, side, q)),
+        | Quantity::ContactMinForce
+        | Quantity::RailZ => Some((k, side, q)),
         _ => None,
     }
 }
@@ -874,9 +875,10 @@ impl Model for FmuModel {
 
     /// TrackContact, every pair its model description declares. Contact interface:
     /// the contact forces and overlaps of each wheelset with respect to its wheel
-    /// heights exactly (the contact stiffness
-    /// [`crate::contact::ContactLaw::stiffness_at`]: `dP/dz = -dP/d delta`; `d delta/dz
-    /// = -1`); the forces with respect to the axle angle, and the patch's front and rear
+    /// heights exactly (the contact stiffness `k`,
+    /// [`crate::contact::ContactLaw::stiffness_at`], in series with the rail's local
+    /// compliance `c` under the wheel ([`crate::track::Track::shear_compliance`]):
+    /// `dP/dz = -k / (1 + c k)`; `d delta/dz = -1 / (1 + c k)`); the forces with respect to the axle angle, and the patch's front and rear
     /// angles and length with respect to either input, by central differences of the
     /// law (1e-9 m, 1e-7 rad); the extremes follow the force where it is the extreme
     /// now, else 0. Axle boxes: the primary forces with respect to their side frame's
@@ -933,36 +935,55 @@ impl Model for FmuModel {
         let law = sim.contact_law();
         let overlap = sample.contact[side].overlap;
         let gamma = sample.rotation;
-        // A central difference of the law's state in the overlap (a height raises it by
-        // as much as it lowers the wheel) or the axle angle.
+        // The rail's local compliance `c` under the wheel, in series with the contact
+        // (the force solves `P = P_law(overlap_0 - c P)`): a change of the overlap the
+        // nodes give moves the overlap by `s = 1 / (1 + c k)` of it.
+        let c = sim.contact_compliance_of(ku);
+        let k = law.stiffness_at(wheel, gamma, overlap);
+        let s = 1.0 / (1.0 + c * k);
+        // Central differences of the law's state in the overlap and the axle angle.
+        let d_overlap = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
+            let e = 1e-9;
+            (pick(&law.evaluate(wheel, gamma, overlap + e))
+                - pick(&law.evaluate(wheel, gamma, overlap - e)))
+                / (2.0 * e)
+        };
+        let d_gamma = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
+            let e = 1e-7;
+            (pick(&law.evaluate(wheel, gamma + e, overlap))
+                - pick(&law.evaluate(wheel, gamma - e, overlap)))
+                / (2.0 * e)
+        };
+        // dP/d gamma with the overlap following it through the compliance.
+        let p_gamma = || s * d_gamma(&|c| c.force);
+        // A quantity of the state: a height raises the overlap by `-s` per metre, the
+        // axle angle moves it by `-c dP/d gamma`.
         let difference = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
             if which == 2 {
-                let e = 1e-7;
-                (pick(&law.evaluate(wheel, gamma + e, overlap))
-                    - pick(&law.evaluate(wheel, gamma - e, overlap)))
-                    / (2.0 * e)
+                d_gamma(pick) - c * p_gamma() * d_overlap(pick)
             } else {
-                let e = 1e-9;
-                -(pick(&law.evaluate(wheel, gamma, overlap + e))
-                    - pick(&law.evaluate(wheel, gamma, overlap - e)))
-                    / (2.0 * e)
+                -s * d_overlap(pick)
             }
         };
         let force = || {
-            if which == 2 {
-                difference(&|c| c.force)
-            } else {
-                -law.stiffness_at(wheel, gamma, overlap)
-            }
+            if which == 2 { p_gamma() } else { -k * s }
         };
         let p = sample.contact[side].force;
         Ok(match q {
             Quantity::ContactForce => force(),
             Quantity::ContactOverlap => {
                 if which == 2 {
-                    0.0
+                    -c * p_gamma()
                 } else {
-                    -1.0
+                    -s
+                }
+            }
+            // The rail under the wheel, lowered by `c P`.
+            Quantity::RailZ => {
+                if which == 2 {
+                    -c * p_gamma()
+                } else {
+                    c * k * s
                 }
             }
             Quantity::ContactFrontAngle => difference(&|c| c.front_angle),
