@@ -192,11 +192,18 @@ def test_results_of_another_version_or_model_are_run_again_not_mixed(study, tmp_
     rec["result"]["guid"] = "{00000000-0000-0000-0000-000000000000}"
     rec["result"]["peak"]["left"] = 1.0
     lines[1] = json.dumps(rec)
+    # The same version and GUID from an engine whose numbers differ (a change of the
+    # numerics keeps both): its fingerprint tells it.
+    rec = json.loads(lines[2])
+    rec["engine"] = "000000000000"
+    rec["result"]["peak"]["left"] = 2.0
+    lines[2] = json.dumps(rec)
     (out / "cases.jsonl").write_text("\n".join(lines) + "\n")
     said = []
     again, n = run_study(s, str(out), serial=True, runner_path=runner, progress=False, plots=False,
                          log=said.append)
-    assert n == 1 and any("1 results of another software version or model GUID" in x for x in said), said
+    assert n == 2 and any("2 results of another software version, model GUID or engine" in x for x in said), said
+    assert len(set(again["engine"])) == 1 and len(again["engine"][0]) == 12
     assert set(again["guid"]) == set(whole["guid"]) and len(set(again["guid"])) == 1
     assert comparable(again).equals(comparable(whole))
 
@@ -383,7 +390,7 @@ def test_every_answer_names_its_case_and_a_shifted_answer_lands_on_no_case(tmp_p
     # Those were passing failures: the real runner runs all three, each its own case.
     r = subprocess.run(cmd + [runner], env=env, capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "3 to run" in r.stdout, (r.stdout, r.stderr)
-    t = pd.read_csv(tmp_path / "o" / "results.csv")
+    t = pd.read_parquet(tmp_path / "o" / "results.parquet")  # exact (pandas' CSV parser may miss an ulp)
     for speed, peak in zip(t["speed"], t["peak.left"]):
         alone = json.loads(subprocess.run([runner], input=f"speed={speed!r} duration=0.05\n", capture_output=True,
                                           text=True, timeout=60).stdout)

@@ -48,7 +48,11 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, stop)
     if args.version:
         from . import build_info
-        print(json.dumps(build_info(), indent=1))
+        try:
+            print(json.dumps(build_info(), indent=1))
+        except RuntimeError as e:
+            print(f"wheelflat-study --version: {e}", file=sys.stderr)
+            return 2
         return 0
     if args.study is None:
         ap.print_usage(sys.stderr)
@@ -72,6 +76,9 @@ def main(argv=None):
     except RuntimeError as e:
         print(str(e), file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("interrupted while building the case runner", file=sys.stderr)
+        return 130
     if not (os.path.isfile(runner) and os.access(runner, os.X_OK)):
         print(f"--runner {runner}: not an executable file (the case runner, target/release/wheelflat_case)",
               file=sys.stderr)

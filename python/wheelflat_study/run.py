@@ -49,7 +49,14 @@ def build_runner():
         return INSTALLED_RUNNER
     if not os.path.isfile(os.path.join(ROOT, "Cargo.toml")):
         raise RuntimeError("no case runner: install the package (docs/guide/studies.md) or give --runner")
-    subprocess.check_call(["cargo", "build", "--release", "--quiet", "--bin", "wheelflat_case"], cwd=ROOT)
+    if not os.path.isfile(RUNNER):
+        print("building the case runner (cargo build --release --bin wheelflat_case; a minute or two the "
+              "first time) ...", file=sys.stderr, flush=True)
+    try:
+        subprocess.check_call(["cargo", "build", "--release", "--quiet", "--bin", "wheelflat_case"], cwd=ROOT)
+    except (OSError, subprocess.CalledProcessError) as e:
+        raise RuntimeError(f"building the case runner failed ({e}): run cargo build --release --bin "
+                           f"wheelflat_case in {ROOT} to see why, or give --runner") from None
     return RUNNER
 
 
@@ -170,21 +177,27 @@ def run_chunk(chunk, runner_path=None):
 
 
 def warm_up(runner_path=None):
-    """Starts this process's runner; its (version, GUID) and cost per simulated second
-    of CoupledSystem's default case (s/s, measured on 0.2 s)."""
+    """Starts this process's runner; its identity (version, GUID, engine) and cost per
+    simulated second of CoupledSystem's default case (s/s, measured on 0.2 s). The
+    engine is a fingerprint of that case's numbers (12 hex digits of the SHA-1 of its
+    answer less the wall time): it changes whenever the model's numbers do, which the
+    version and GUID need not (a change of the numerics keeps the variables)."""
     r = _runner(runner_path).run("duration=0.2", "warm-up")
     if r.get("error"):
         raise RuntimeError(f"the case runner {runner_path or default_runner()} fails: {r['error']}")
-    return (r.get("version"), r.get("guid")), r["wall_s"] / 0.2
+    numbers = {k: v for k, v in r.items() if k not in ("wall_s", "warnings")}
+    import hashlib
+    engine = hashlib.sha1(json.dumps(numbers, sort_keys=True).encode()).hexdigest()[:12]
+    return (r.get("version"), r.get("guid"), engine), r["wall_s"] / 0.2
 
 
 def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
     """The results already in the study's folder, by case id. Lines that are not a
     whole record (cut by an interruption, or damaged) are skipped, so their cases run
     again; so do cases that failed for a passing reason (a stopped runner, a lost
-    worker), with `retry_failed` every failed case, and, given `ident` (version, GUID),
-    results of another software version or GUID (one table holds one model's
-    results); `load_done.other` counts those. ids_only: the records' ids only (what a
+    worker), with `retry_failed` every failed case, and, given `ident` (version, GUID,
+    engine fingerprint), results of another software version, GUID or engine (one
+    table holds one model's results); `load_done.other` counts those. ids_only: the records' ids only (what a
     start needs; a million records' parameters would not fit in the memory a start has)."""
     load_done.other = 0
     path = os.path.join(out_dir, "cases.jsonl")
@@ -204,7 +217,7 @@ def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
                     done.pop(rec["id"], None)
                     continue
                 if ident is not None and res.get("version") is not None \
-                        and (res.get("version"), res.get("guid")) != tuple(ident):
+                        and (res.get("version"), res.get("guid"), rec.get("engine")) != tuple(ident):
                     done.pop(rec["id"], None)
                     load_done.other += 1
                     continue
@@ -264,8 +277,9 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     ident, cost = warm_up(runner_path or build_runner())
     done = set(load_done(out_dir, retry_failed, ident, ids_only=True))
     if load_done.other:
-        log(f"{study.name}: {load_done.other} results of another software version or model GUID in "
-            f"{out_dir} are set aside and run again (this runner: version {ident[0]}, GUID {ident[1]})")
+        log(f"{study.name}: {load_done.other} results of another software version, model GUID or engine in "
+            f"{out_dir} are set aside and run again (this runner: version {ident[0]}, GUID {ident[1]}, "
+            f"engine {ident[2]})")
     total = study.count()
     have = sum(1 for c in study.iter_cases() if c.id in done) if done else 0
     log(f"{study.name}: {total} cases, {have} already done, {total - have} to run")
@@ -279,7 +293,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     ready = time.perf_counter()
     if total > have:
         if serial:
-            _serial(todo, total - have, out_dir, runner_path, progress, limit)
+            _serial(todo, total - have, out_dir, runner_path, progress, limit, ident[2])
         else:
             ready = _dask(todo, total - have, out_dir, runner_path, scheduler, workers, chunk, progress, limit,
                           ident)
@@ -298,9 +312,9 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     return table, total - have
 
 
-def _record(cid, res, wall, case):
+def _record(cid, res, wall, case, engine):
     return {"id": cid, "params": case.params, "duration": case.duration, "keep": list(case.keep),
-            "result": res, "wall_s": wall}
+            "result": res, "wall_s": wall, "engine": engine}
 
 
 def _bar(total, progress):
@@ -310,12 +324,12 @@ def _bar(total, progress):
     return tqdm(total=total, unit="case", file=sys.stderr)
 
 
-def _serial(todo, count, out_dir, runner_path, progress, limit):
+def _serial(todo, count, out_dir, runner_path, progress, limit, engine):
     """Runs the `count` cases of the iterator `todo` here, in order."""
     bar = _bar(count, progress)
     for case in todo:
         [(cid, res, wall)] = run_chunk([(case.id, case.line(), limit(case))], runner_path)
-        _append(out_dir, [_record(cid, res, wall, case)])
+        _append(out_dir, [_record(cid, res, wall, case, engine)])
         if bar:
             bar.update(1)
     if bar:
@@ -352,9 +366,10 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
             raise RuntimeError(f"a worker cannot start its case runner: {type(e).__name__}: {e}") from None
         other = {w: tuple(i) for w, (i, _) in answers.items() if tuple(i) != tuple(ident)}
         if other:
-            raise RuntimeError("workers with another version or model GUID than this one's (version "
-                               f"{ident[0]}, GUID {ident[1]}): "
-                               + ", ".join(f"{w}: version {v}, GUID {g}" for w, (v, g) in other.items()))
+            raise RuntimeError("workers with another version, model GUID or engine than this one's (version "
+                               f"{ident[0]}, GUID {ident[1]}, engine {ident[2]}): "
+                               + ", ".join(f"{w}: version {v}, GUID {g}, engine {e}"
+                                           for w, (v, g, e) in other.items()))
         ready = time.perf_counter()
         nworkers = max(1, len(answers))
         # Chunks of a few cases: the scheduler's cost per task is shared, and every
@@ -383,7 +398,7 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
                 results = [(cid, {"error": f"{type(e).__name__}: {e}", "transient": True}, 0.0)
                            for cid in cases]
             fut.release()
-            _append(out_dir, [_record(cid, res, wall, cases[cid]) for cid, res, wall in results])
+            _append(out_dir, [_record(cid, res, wall, cases[cid], ident[2]) for cid, res, wall in results])
             send()
             if bar:
                 bar.update(len(results))
