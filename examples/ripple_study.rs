@@ -5,24 +5,17 @@
 //! its spectrum is the harmonics `k V / a`; the n-th harmonic is the node-passing line
 //! `n V / a`. Prints, per n: the peak to peak, the sleeper-passing line (k = 1) and the
 //! node-passing line (k = n) as amplitudes (kN) of their harmonic, projected over whole
-//! periods. `cargo run --release --example ripple_study [N]...` (default 4 8 16 32).
+//! periods. `cargo run --release --example ripple_study [linear] [N]...` (default
+//! 4 8 16 32; `linear`: the rail between nodes by the thesis' (3.23), as before
+//! issue 27).
+use wheelflat::numerics::harmonic_amplitude as amplitude;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow};
-
-/// Amplitude (N) of the harmonic of frequency `f` (Hz) in `x` sampled every `dt` s
-/// from 0, over a whole number of its periods (the caller's window).
-fn amplitude(x: &[f64], dt: f64, f: f64) -> f64 {
-    let (mut c, mut s) = (0.0, 0.0);
-    for (j, v) in x.iter().enumerate() {
-        let ph = std::f64::consts::TAU * f * j as f64 * dt;
-        c += v * ph.cos();
-        s += v * ph.sin();
-    }
-    2.0 * c.hypot(s) / x.len() as f64
-}
+use wheelflat::track::RailBetweenNodes;
 
 fn main() {
+    let linear = std::env::args().nth(1).as_deref() == Some("linear");
     let ns: Vec<usize> = std::env::args()
-        .skip(1)
+        .skip(1 + usize::from(linear))
         .map(|a| a.parse().expect("n"))
         .collect();
     let ns = if ns.is_empty() {
@@ -37,6 +30,9 @@ fn main() {
     for n in ns {
         let mut s = Scenario::table_4_4();
         s.set_nodes_per_span(n);
+        if linear {
+            s.set_between_nodes(RailBetweenNodes::Linear);
+        }
         s.window = Some(TrackWindow::DEFAULT);
         s.start_position = 10.0 * 0.685;
         let mut sim = Simulation::new(&s).unwrap();

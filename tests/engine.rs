@@ -349,3 +349,56 @@ fn ten_flat_impacts_at_0_99_of_the_reported_limit_stay_bounded() {
     // Peaks of 314 to 441 kN per revolution (examples/stability_limit.rs).
     assert!(peak < 460e3, "{peak}");
 }
+
+/// The quiet force's sleeper-passing (`V / a`) and node-passing (`n V / a`) lines (N):
+/// table 4.4, perfect wheels, 70 km/h, the endless track, the left wheel's force over
+/// whole sleeper-passing periods (about half a second) after 0.2 s.
+fn quiet_lines(n: usize, between: RailBetweenNodes) -> (f64, f64) {
+    use wheelflat::numerics::harmonic_amplitude;
+    use wheelflat::sim::TrackWindow;
+    let mut s = Scenario::table_4_4();
+    s.set_nodes_per_span(n);
+    s.set_between_nodes(between);
+    s.window = Some(TrackWindow::DEFAULT);
+    s.start_position = 10.0 * 0.685;
+    let mut sim = Simulation::new(&s).unwrap();
+    let dt = sim.dt();
+    let f1 = s.speed / 0.685;
+    sim.run(0.2, |_| {}).unwrap();
+    let periods = (0.5 * f1).floor();
+    let steps = (periods / f1 / dt).round() as usize;
+    let mut x = Vec::with_capacity(steps);
+    for _ in 0..steps {
+        x.push(sim.step().unwrap().contact[0].force);
+    }
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    x.iter_mut().for_each(|v| *v -= mean);
+    let f = periods / (steps as f64 * dt);
+    (
+        harmonic_amplitude(&x, dt, f),
+        harmonic_amplitude(&x, dt, n as f64 * f),
+    )
+}
+
+#[test]
+fn the_node_passing_ripple_is_gone_and_keeps_shrinking_with_the_grid() {
+    // Issue 27: with the rail between nodes by (3.23) the largest line of the quiet
+    // force was the wheel load passing from node to node, 1.66 kN at n = 8 (227 Hz),
+    // twice the physical sleeper-passing line. With the beam's shape between nodes
+    // (measured over 1 s, examples/ripple_study.rs): 0.153 kN at n = 8, 0.063 kN at
+    // n = 16, 0.041 kN at n = 32, while the sleeper-passing line converges (0.903,
+    // 0.949, 0.961 kN).
+    let (s8, n8) = quiet_lines(8, RailBetweenNodes::Beam);
+    let (s16, n16) = quiet_lines(16, RailBetweenNodes::Beam);
+    let (s32, _) = quiet_lines(32, RailBetweenNodes::Beam);
+    let (_, linear8) = quiet_lines(8, RailBetweenNodes::Linear);
+    assert!(n8 < 300.0, "node passing at n = 8: {n8} N");
+    assert!(
+        n16 < 150.0 && n16 < 0.6 * n8,
+        "node passing at n = 16: {n16} N (n = 8: {n8} N)"
+    );
+    assert!(linear8 > 1400.0, "(3.23) at n = 8: {linear8} N");
+    // The physical line converges to the refined grid's.
+    assert!(((s8 - s32) / s32).abs() < 0.08, "{s8} vs {s32}");
+    assert!(((s16 - s32) / s32).abs() < 0.03, "{s16} vs {s32}");
+}

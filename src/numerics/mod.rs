@@ -1,10 +1,12 @@
 //! Numerics with no physics in them: the instruction-set dispatch of the hot loops,
 //! the small-angle functions the wheel profile and the contact evaluate, root finding,
-//! Gauss-Legendre quadrature, the banded solver of the static start and the central
-//! differences of the vehicles' bodies.
+//! Gauss-Legendre quadrature, the banded solver of the static start, the central
+//! differences of the vehicles' bodies and the amplitude of a harmonic in a signal (for
+//! measuring the quiet force's spectrum).
 
 mod banded;
 mod central_difference;
+mod harmonic;
 mod quadrature;
 mod roots;
 mod simd;
@@ -12,6 +14,7 @@ mod small_angle;
 
 pub(crate) use banded::solve_banded_spd;
 pub(crate) use central_difference::{CentralDifference, check_critical_step};
+pub use harmonic::harmonic_amplitude;
 pub(crate) use quadrature::gauss_legendre;
 pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};
