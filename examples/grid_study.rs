@@ -1,11 +1,21 @@
 //! Grid-convergence study of the peak impact force for the reference case
 //! (table 4.4, 70 km/h, 100 mm x 1.5 mm haversine flat on the left wheel, 30 spans):
 //! n = 1, 2, 3, 4, 6, 8 nodes per span, each at dt = 0.5 dt_c and dt = 0.25 dt_c, plus
-//! the seed's own grid (n = 2, dt = 45 us). Prints a markdown table.
+//! the seed's own grid (n = 2, dt = 45 us). Prints a markdown table. The rail between
+//! nodes as a beam (the default); `BETWEEN_NODES=linear` for the thesis' (3.23).
 use wheelflat::sim::{Scenario, Simulation};
+use wheelflat::track::RailBetweenNodes;
+
+fn scenario() -> Scenario {
+    let mut s = Scenario::table_4_4_flat();
+    if std::env::var("BETWEEN_NODES").as_deref() == Ok("linear") {
+        s.set_between_nodes(RailBetweenNodes::Linear);
+    }
+    s
+}
 
 fn peak(n: usize, dt: f64) -> (f64, f64, f64) {
-    let mut s = Scenario::table_4_4_flat();
+    let mut s = scenario();
     s.set_nodes_per_span(n);
     s.dt = dt;
     let mut sim = Simulation::new(&s).unwrap();
@@ -36,7 +46,7 @@ fn main() {
         ns
     };
     for n in ns {
-        let mut s = Scenario::table_4_4_flat();
+        let mut s = scenario();
         s.set_nodes_per_span(n);
         let wheelflat::sim::TrackSpec::Discrete(t) = s.track else {
             unreachable!()

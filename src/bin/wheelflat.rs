@@ -3,7 +3,8 @@
 //! ```text
 //! wheelflat [--preset table4.4-flat] [--speed KMH] [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:chord]]...
 //!           [--no-flats] [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5]
-//!           [--n NODES_PER_SPAN] [--dt-us US] [--spans N] [--start M] [--site M]... [--duration S]
+//!           [--n NODES_PER_SPAN] [--between-nodes beam|linear] [--dt-us US] [--spans N]
+//!           [--start M] [--site M]... [--duration S]
 //!           [--every K] [--output FILE.csv]
 //! ```
 
@@ -12,11 +13,13 @@ use std::process::ExitCode;
 use std::time::Instant;
 use wheelflat::contact::ContactModel;
 use wheelflat::sim::{Scenario, Simulation, kmh};
+use wheelflat::track::RailBetweenNodes;
 use wheelflat::wheel::{FlatShape, FlatSpec};
 
 const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:haversine|chord]]... [--no-flats] \
-[--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5] [--n NODES_PER_SPAN] [--dt-us US] \
+[--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5] [--n NODES_PER_SPAN] \
+[--between-nodes beam|linear] [--dt-us US] \
 [--spans N] [--start M] [--site M]... [--duration S] [--every K] [--output FILE.csv]
 presets: table4.4 table4.4-flat (default) table4.1 table5.1 table5.2 chapter2";
 
@@ -103,6 +106,16 @@ fn run() -> Result<(), String> {
                     o => return Err(format!("--contact {o:?}: expected adaptive or hertz")),
                 }
             }
+            "--between-nodes" => scenario.set_between_nodes(match v.as_deref() {
+                Some("beam") => RailBetweenNodes::Beam,
+                Some("linear") => RailBetweenNodes::Linear,
+                o => {
+                    return Err(format!(
+                        "--between-nodes {o:?}: expected beam (the default) or linear (the \
+                         thesis' (3.23))"
+                    ));
+                }
+            }),
             "--kw" => scenario.kw = num(&flag, v)?,
             "--ch" => scenario.hertz_coefficient = num(&flag, v)?,
             "--n" => {

@@ -704,9 +704,9 @@ impl Model for FmuModel {
                     format!(
                         "at t = {time} s the communication step {} s is {ratio:.1} track steps \
                      (solver.step = {} s) with {}: the contact exchange's error grows with \
-                     the step (peak of the reference flat: held heights +1.3 %, +5.5 %, +12 % \
-                     at 2, 5, 10 track steps under a sequential master, +2.4 %, +8.6 %, +20 % \
-                     under a Jacobi one; with the wheel velocities +0.7 % at 5, +2.9 % at 10); \
+                     the step (peak of the reference flat: held heights +1.1 %, +4.2 %, +12 % \
+                     at 2, 5, 10 track steps under a sequential master, +2.2 %, +7.0 %, +19 % \
+                     under a Jacobi one; with the wheel velocities +0.7 % at 5, +3.3 % at 10); \
                      use at most {} s, give the wheel velocities (fmi2SetRealInputDerivatives), \
                      or couple at the axle boxes (interface = axle_box)",
                         num(self.last_step),

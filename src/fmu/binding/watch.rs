@@ -4,9 +4,11 @@
 //! * the communication step against the track's own: the wheel heights are held over a
 //!   step (or extrapolated with the derivatives of `fmi2SetRealInputDerivatives`), so
 //!   the exchange's error grows with the step (measured on the reference flat, peak of
-//!   the leading wheel: held heights under a sequential master +1.3 % at 2 track steps,
-//!   +5.5 % at 5, +12 % at 10; under a Jacobi master, OSP libcosim and ecos, +2.4 %,
-//!   +8.6 % and +20 %; with the wheel velocities +0.7 % at 5 and +2.9 % at 10);
+//!   the leading wheel over 0.3 s: held heights under a sequential master +1.1 % at 2
+//!   track steps, +4.2 % at 5, +12 % at 10; under a Jacobi master, OSP libcosim and
+//!   ecos, +2.2 %, +7.0 % and +19 %; with the wheel velocities +0.7 % at 5 and +3.3 %
+//!   at 10; +1.3, +5.5, +12, +2.4, +8.6, +20, +0.7 and +2.9 % with the rail between
+//!   nodes by (3.23));
 //! * chatter: a contact force that jumps up and down at every communication point, the
 //!   mark of an explicit exchange beyond its stability (10 track steps, Jacobi: peaks
 //!   of 615 kN and contact lost 31 % of the time, every force under the health bound);
