@@ -49,12 +49,33 @@ pub(super) fn adaptive(
     out: &mut ContactState,
 ) {
     match wheel {
-        WheelProfile::Flatted(w) => flatted(kw, w, gamma, overlap, force_numeric, out),
+        WheelProfile::Flatted(w) => {
+            flatted(kw, w, gamma, overlap, force_numeric, out);
+        }
+    }
+}
+
+/// [`adaptive`] and its stiffness `dP / d delta` (N/m, as [`adaptive_stiffness`]) from
+/// the same pass, and whether the pass integrated (a flat in the patch: the costly
+/// path): the contact's solve in series with the rail's compliance needs all three.
+/// The state is [`adaptive`]'s, bit for bit.
+#[inline(always)]
+pub(super) fn adaptive_and_stiffness(
+    kw: f64,
+    wheel: &WheelProfile,
+    gamma: f64,
+    overlap: f64,
+    out: &mut ContactState,
+) -> (f64, bool) {
+    match wheel {
+        WheelProfile::Flatted(w) => flatted(kw, w, gamma, overlap, false, out),
     }
 }
 
 /// [`adaptive`] for the nominal circle with flats: the closed form (2.5) when no flat
-/// reaches into the perfect-wheel patch, else the integral.
+/// reaches into the perfect-wheel patch, else the integral; returns the stiffness
+/// `dP / d delta` (N/m, 0 out of contact) and whether it integrated, which
+/// [`adaptive`] drops.
 #[inline(always)]
 fn flatted(
     kw: f64,
@@ -63,14 +84,14 @@ fn flatted(
     overlap: f64,
     force_numeric: bool,
     out: &mut ContactState,
-) {
+) -> (f64, bool) {
     let rw = wheel.radius();
     if overlap <= 0.0 || overlap.is_nan() {
         *out = ContactState {
             overlap,
             ..Default::default()
         };
-        return;
+        return (0.0, false);
     }
     let delta = overlap.min(rw);
     let (aw, sin_minus_x_cos_aw, s2) = perfect_patch_scaled(delta * wheel.half_inv_radius());
@@ -85,9 +106,11 @@ fn flatted(
             length: 4.0 * rw * (s2 * (1.0 - s2)).sqrt(),
             intervals: 1,
         };
-        return;
+        return (2.0 * kw * aw, false);
     }
-    *out = adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric);
+    let (state, angle) = adaptive_flats(kw, wheel, &near[..nf], overlap, delta, aw, force_numeric);
+    *out = state;
+    (kw * angle, true)
 }
 
 /// The flats whose window (space angles) reaches into the patch `[-aw, aw]` (rad) at
@@ -137,6 +160,7 @@ pub fn adaptive_stiffness(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f6
 /// has) and dispatched here:
 /// the integrand is evaluated [`LANES`] points at a time where it can be, and those
 /// evaluations vectorise. No FMA at any level, so every level gives the same bits.
+/// Returns the state and the total angle of the compressed springs (rad).
 #[inline(never)]
 fn adaptive_flats(
     kw: f64,
@@ -146,10 +170,10 @@ fn adaptive_flats(
     delta: f64,
     aw: f64,
     force_numeric: bool,
-) -> ContactState {
+) -> (ContactState, f64) {
     SimdLevel::detect().run(
         #[inline(always)]
-        || adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric).0,
+        || adaptive_flats_body(kw, wheel, near, overlap, delta, aw, force_numeric),
     )
 }
 

@@ -110,6 +110,12 @@ impl Simulation {
             };
             let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));
             let zw = [zr[0] - delta[0], zr[1] - delta[1]];
+            // The static loads start the first step's contact solve (the force of
+            // "the step before"), so a wheelset at rest stays there to rounding.
+            let latest = &mut self.wheelsets.get_mut(k).expect("k < len").latest;
+            for (c, &f) in latest.contact.iter_mut().zip(&p) {
+                c.force = f;
+            }
             match &mut self.wheelsets.get_mut(k).expect("k < len").vehicle {
                 VehicleState::RollPlane(v) => v.set_static(zw)?,
                 VehicleState::AxleBox(link) => link.set_static(zw, p),
