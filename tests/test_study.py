@@ -81,9 +81,11 @@ def test_a_scheduler_and_two_workers_on_loopback_give_the_same_table(study, tmp_
                                       "--no-dashboard"], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
     try:
         time.sleep(2.0)
+        # The second worker has two threads (dask worker's default is one per core):
+        # one runner per thread, so its cases do not race on one runner.
         for k in range(2):
             procs.append(subprocess.Popen(dask + ["distributed.cli.dask_worker", addr, "--nworkers", "1", "--nthreads",
-                                                  "1", "--no-dashboard", "--name", f"w{k}"],
+                                                  str(k + 1), "--no-dashboard", "--name", f"w{k}"],
                                           env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         from dask.distributed import Client
         with Client(addr, timeout=30) as c:
@@ -189,13 +191,13 @@ def test_results_of_another_version_or_model_are_run_again_not_mixed(study, tmp_
                          log=lambda *_: None)
     lines = (out / "cases.jsonl").read_text().splitlines()
     rec = json.loads(lines[1])
-    rec["result"]["guid"] = "{00000000-0000-0000-0000-000000000000}"
+    rec["result"]["guid"] = rec["identity"][1] = "{00000000-0000-0000-0000-000000000000}"
     rec["result"]["peak"]["left"] = 1.0
     lines[1] = json.dumps(rec)
     # The same version and GUID from an engine whose numbers differ (a change of the
     # numerics keeps both): its fingerprint tells it.
     rec = json.loads(lines[2])
-    rec["engine"] = "000000000000"
+    rec["identity"][2] = "000000000000"
     rec["result"]["peak"]["left"] = 2.0
     lines[2] = json.dumps(rec)
     (out / "cases.jsonl").write_text("\n".join(lines) + "\n")
@@ -233,13 +235,26 @@ def test_a_runner_that_is_not_there_is_refused(tmp_path, study):
 
 
 def test_a_chunk_or_worker_count_below_one_is_refused(tmp_path, study, runner):
-    # Issue 26 item 4: `--chunk -5` printed "ran 3 cases" and ran none.
+    # Issue 26 item 4: `--chunk -5` printed "ran 3 cases" and ran none; a huge one was
+    # a traceback after the cluster had started, a huge worker count hung.
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
-    for flag in ("--chunk", "--workers"):
-        r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(study), flag, "-5", "--out",
-                            str(tmp_path / "o"), "--runner", runner, "--no-progress"], env=env,
-                           capture_output=True, text=True, timeout=60)
-        assert r.returncode == 2 and f"{flag} -5: at least 1" in r.stderr, r.stderr
+    for flag, v, said in (("--chunk", "-5", "--chunk -5: 1 to 1000000"),
+                          ("--chunk", "99999999999999999999", "1 to 1000000"),
+                          ("--workers", "-5", "--workers -5: 1 to 1024"),
+                          ("--workers", "99999999999999999999", "1 to 1024"),
+                          ("--case-time-limit", "1e10", "--case-time-limit 1e+10: 0 < S <= 1e+06 s"),
+                          ("--case-time-limit", "nan", "0 < S"),
+                          ("--scheduler", "foo", "--scheduler 'foo': an address such as tcp://HOST:8786"),
+                          ("--runner", "/bin/echo", "does not answer as the case runner does"),
+                          ("--runner", "/bin/false", "does not answer as the case runner does"),
+                          ("--out", "/proc/nope", "--out /proc/nope: cannot write there")):
+        args = [sys.executable, "-m", "wheelflat_study", str(study), flag, v, "--no-progress"]
+        if flag != "--runner":
+            args += ["--runner", runner]
+        if flag != "--out":
+            args += ["--out", str(tmp_path / "o")]
+        r = subprocess.run(args, env=env, capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and said in r.stderr and "Traceback" not in r.stderr, (flag, v, r.stderr)
 
 
 def test_the_tables_are_written_whole_or_not_at_all(tmp_path, monkeypatch):
@@ -330,6 +345,14 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [0.0, -0.0]\n', "the same case twice"),
     ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [1.0]\n[[plot]]\nname = "../../../x"\nkind = "lines"\nx = "speed"\n'
      'y = ["peak.left"]\n', "plot 1: name = `../../../x`"),
+    # The review's: these ran every case and then failed, or gave tracebacks.
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [1.0]\n[[plot]]\nkind = "lines"\nx = "speed"\n'
+     'y = ["peak.left"]\n', "plot 1: y = ['peak.left']: a column name or text"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [1.0]\n[[plot]]\nkind = ["lines"]\nx = "speed"\ny = "p"\n',
+     "plot 1: kind one of"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { values = 5 }\n', "values = 5: a list of numbers"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = { values = [1.0], unit = [1] }\n', "unit `[1]`"),
+    ('name = "s"\nduration = 0.1\n[fixed]\nspeed = { value = 1.0, unit = { a = 1 } }\n', "unit `{'a': 1}`"),
 ])
 def test_bad_study_files_are_refused_before_anything_runs(tmp_path, runner, text, said):
     p = tmp_path / "s.toml"
@@ -589,3 +612,75 @@ def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_witho
                           progress=False, plots=False, log=lambda *_: None)
     assert len(remote) == 8 and (remote["status"] == "ok").all()
     assert comparable(remote).equals(comparable(serial))
+
+
+OTHER_ENGINE_RUNNER = """#!{python}
+import json, subprocess, sys
+child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                         bufsize=1)
+if sys.argv[1:]:
+    sys.stdout.write(child.communicate()[0])
+    sys.exit(0)
+for line in sys.stdin:
+    child.stdin.write(line)
+    child.stdin.flush()
+    answer = json.loads(child.stdout.readline())
+    for k in answer.get("peak") or {{}}:
+        answer["peak"][k] *= 1.5      # another engine: same version and GUID, other numbers
+    sys.stdout.write(json.dumps(answer) + "\\n")
+    sys.stdout.flush()
+"""
+
+
+def test_a_worker_that_joins_later_with_another_engine_is_retired_and_its_cases_run_elsewhere(tmp_path, runner):
+    # Issue 26 review: the model's identity was checked once, at the start; a worker
+    # that joined later with another engine (same version and GUID, other numbers) had
+    # its results kept, stamped with the study's engine.
+    import shutil
+    pkg_b = tmp_path / "pkg_b"
+    shutil.copytree(os.path.join(ROOT, "python", "wheelflat_study"), pkg_b / "wheelflat_study",
+                    ignore=shutil.ignore_patterns("__pycache__", "_data"))
+    fake = pkg_b / "wheelflat_study" / "_data" / "bin" / "wheelflat_case"
+    fake.parent.mkdir(parents=True)
+    fake.write_text(OTHER_ENGINE_RUNNER.format(python=sys.executable, runner=runner))
+    fake.chmod(0o755)
+    p = tmp_path / "late.toml"
+    p.write_text('name = "late"\nduration = 0.05\n[sweep]\nstart_position = { range = [3.0, 6.99, 0.01] }\n')
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    env_a = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    env_b = dict(os.environ, PYTHONPATH=str(pkg_b))
+    dask = [sys.executable, "-m"]
+    quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    procs = [subprocess.Popen(dask + ["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                                      "--no-dashboard"], env=env_a, **quiet)]
+    out = tmp_path / "o"
+    try:
+        time.sleep(2.0)
+        procs.append(subprocess.Popen(dask + ["distributed.cli.dask_worker", addr, "--nthreads", "1",
+                                              "--no-dashboard", "--name", "a"], env=env_a, **quiet))
+        study = subprocess.Popen([sys.executable, "-m", "wheelflat_study", str(p), "--scheduler", addr, "--out",
+                                  str(out), "--no-progress", "--no-plots", "--chunk", "2"], env=env_a,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        records = out / "cases.jsonl"
+        deadline = time.time() + 120
+        while not (records.exists() and records.stat().st_size > 0) and time.time() < deadline:
+            time.sleep(0.05)
+        procs.append(subprocess.Popen(dask + ["distributed.cli.dask_worker", addr, "--nthreads", "1",
+                                              "--no-dashboard", "--name", "b"], env=env_b, **quiet))
+        stdout, stderr = study.communicate(timeout=300)
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        for proc in procs:
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+    assert study.returncode == 0, (stdout, stderr)
+    assert "runs another model" in stderr and "retired" in stderr, stderr
+    import pandas as pd
+    table = pd.read_parquet(out / "results.parquet")
+    serial, _ = run_study(load_study(p), str(tmp_path / "serial"), serial=True, runner_path=runner, progress=False,
+                          plots=False, log=lambda *_: None)
+    assert len(table) == 400 and comparable(table).equals(comparable(serial))

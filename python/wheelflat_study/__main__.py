@@ -14,7 +14,9 @@ import json
 import os
 import sys
 
-from .run import MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study
+from .run import (MAX_TIME_LIMIT, MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study,
+                  stop_runners)
+from .spec import MAX_CASES
 from .spec import load_study
 
 
@@ -59,18 +61,26 @@ def main(argv=None):
         print("wheelflat-study: the study file is needed", file=sys.stderr)
         return 2
     limit = args.case_time_limit
-    if limit is not None and not (limit > 0 and limit < float("inf")):
-        print(f"--case-time-limit {limit:g}: a number of seconds above 0", file=sys.stderr)
+    if limit is not None and not 0 < limit <= MAX_TIME_LIMIT:
+        print(f"--case-time-limit {limit:g}: 0 < S <= {MAX_TIME_LIMIT:g} s", file=sys.stderr)
         return 2
-    for flag, v in (("--chunk", args.chunk), ("--workers", args.workers)):
-        if v is not None and v < 1:
-            print(f"{flag} {v}: at least 1", file=sys.stderr)
+    for flag, v, most in (("--chunk", args.chunk, MAX_CASES), ("--workers", args.workers, 1024)):
+        if v is not None and not 1 <= v <= most:
+            print(f"{flag} {v}: 1 to {most}", file=sys.stderr)
             return 2
+    if args.scheduler is not None and not (args.scheduler.startswith(("tcp://", "tls://", "inproc://",
+                                                                         "ucx://", "ws://", "wss://"))
+                                           or ":" in args.scheduler):
+        print(f"--scheduler {args.scheduler!r}: an address such as tcp://HOST:8786", file=sys.stderr)
+        return 2
     try:
         study = load_study(args.study)
     except (OSError, ValueError) as e:
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
+    if args.runner is not None:
+        # A bare name would be looked up on PATH by the processes that start it.
+        args.runner = os.path.abspath(args.runner)
     try:
         runner = args.runner or build_runner()
     except RuntimeError as e:
@@ -89,7 +99,17 @@ def main(argv=None):
     except ValueError as e:
         print(f"{args.study}: {e}", file=sys.stderr)
         return 2
+    except RuntimeError as e:
+        print(str(e), file=sys.stderr)
+        return 2
     out = args.out or os.path.join("results" if installed() else os.path.join(ROOT, "results"), study.name)
+    try:
+        os.makedirs(out, exist_ok=True)
+        with open(os.path.join(out, ".lock"), "a"):
+            pass
+    except OSError as e:
+        print(f"--out {out}: cannot write there ({e.strerror or e})", file=sys.stderr)
+        return 2
     try:
         # Without --runner each worker runs its own install's runner (checked to be
         # this one's version and GUID), so a cluster's hosts need no shared path.
@@ -98,7 +118,8 @@ def main(argv=None):
                              progress=not args.no_progress, plots=not args.no_plots,
                              retry_failed=args.retry_failed, time_limit=limit)
     except KeyboardInterrupt:
-        print("interrupted: the cases done so far are kept; run the same command to go on", file=sys.stderr)
+        stop_runners()
+        print("\ninterrupted: the cases done so far are kept; run the same command to go on", file=sys.stderr)
         return 130
     except RuntimeError as e:
         print(f"{args.study}: {e}", file=sys.stderr)
@@ -126,14 +147,22 @@ def check_variables(study, runner):
     """Refuses, before anything runs, a variable CoupledSystem does not have and a value
     outside its range (as fmi2SetReal would), naming both."""
     import subprocess
-    listing = subprocess.run([runner, "--variables"], capture_output=True, text=True, check=True).stdout
-    known, outputs = {}, set()
-    for line in listing.splitlines():
-        name, ty, lo, hi = line.split("\t")
-        if ty == "output":
-            outputs.add(name)
-        else:
-            known[name] = (ty, float(lo), float(hi))
+    try:
+        listing = subprocess.run([runner, "--variables"], capture_output=True, text=True, check=True,
+                                 timeout=60).stdout
+        known, outputs = {}, set()
+        for line in listing.splitlines():
+            name, ty, lo, hi = line.split("\t")
+            if ty == "output":
+                outputs.add(name)
+            else:
+                known[name] = (ty, float(lo), float(hi))
+        if not known or not outputs:
+            raise ValueError("no variables listed")
+    except (OSError, ValueError, subprocess.SubprocessError) as e:
+        raise RuntimeError(f"--runner {runner}: does not answer as the case runner does ({type(e).__name__}: "
+                           f"{str(e)[:200]}); give target/release/wheelflat_case or the installed "
+                           f"wheelflat-case's program") from None
     # A kept name goes into the runner's line as it is: one that is not an output (a
     # blank in it, another token, a newline) would set a parameter or shift the answers.
     for name in study.keep:

@@ -118,7 +118,7 @@ class CaseRunner:
         try:
             self.proc.stdin.write(f"case={case_id} {line}\n".encode())
             self.proc.stdin.flush()
-            out = self._readline(None if limit is None else t0 + limit)
+            out = self._readline(None if limit is None else t0 + min(limit, MAX_TIME_LIMIT))
         except (BrokenPipeError, OSError) as e:
             out, why = b"", str(e)
         else:
@@ -142,29 +142,68 @@ class CaseRunner:
             return {"error": f"the case runner answered {got!r} to case {case_id!r} (the runner was "
                              f"restarted)", "transient": True}
         del res["case"]
+        if not (res.get("error") or (isinstance(res.get("version"), str) and isinstance(res.get("guid"), str)
+                                     and isinstance(res.get("peak"), dict))):
+            self._kill()
+            return {"error": "the case runner's answer has no version, GUID or peaks: not the case runner "
+                             "(the runner was restarted)", "transient": True}
         return res
 
 
+# The most wall time a case may be given (s): select() takes no more.
+MAX_TIME_LIMIT = 1e6
+
+# One runner per (path, thread): a Dask worker with several threads runs a case in each.
 _RUNNERS = {}
+_IDENTITIES = {}
+_LOCK = __import__("threading").Lock()
 
 
 def _runner(path):
-    """The case runner of this process (one per Dask worker process); `path` None:
-    this installation's own (on a cluster's worker: the worker's install)."""
+    """The case runner of this thread (one per Dask worker thread); `path` None: this
+    installation's own (on a cluster's worker: the worker's install)."""
+    import threading
     path = path or default_runner()
     if path is None:
         raise RuntimeError("no case runner on this worker: install the wheelflat package there "
                            "(docs/guide/studies.md)")
-    r = _RUNNERS.get(path)
-    if r is None:
-        r = _RUNNERS[path] = CaseRunner(path)
+    key = (path, threading.get_ident())
+    with _LOCK:
+        r = _RUNNERS.get(key)
+        if r is None:
+            r = _RUNNERS[key] = CaseRunner(path)
     return r
 
 
+def stop_runners():
+    """Ends every case runner of this process (at an interruption: a runner left alone
+    would finish its case for nobody)."""
+    with _LOCK:
+        runners = list(_RUNNERS.values())
+        _RUNNERS.clear()
+    for r in runners:
+        r._kill()
+
+
+def identity(runner_path=None):
+    """(version, GUID, engine) of this process's runner at `runner_path` (None: its own
+    install's), measured once per process ([`warm_up`])."""
+    path = runner_path or default_runner()
+    with _LOCK:
+        known = _IDENTITIES.get(path)
+    if known is None:
+        known = warm_up(path)[0]
+    return known
+
+
 def run_chunk(chunk, runner_path=None):
-    """Runs the cases of `chunk` (a list of (case id, runner line, time limit s));
-    a list of (case id, result dict, wall seconds in this function)."""
+    """Runs the cases of `chunk` (a list of (case id, runner line, time limit s)) in
+    this thread's runner; (the runner's identity (version, GUID, engine), where it ran
+    (the Dask worker's address, or None), a list of (case id, result dict, wall seconds
+    in this function)). The identity lets the study keep only results of its own model,
+    also from workers that joined after it started."""
     out = []
+    ident = identity(runner_path)
     r = _runner(runner_path)
     for cid, line, limit in chunk:
         t0 = time.perf_counter()
@@ -173,7 +212,12 @@ def run_chunk(chunk, runner_path=None):
         except Exception as e:  # a failing case is recorded, the study goes on
             res = {"error": f"{type(e).__name__}: {e}", "transient": True}
         out.append((cid, res, time.perf_counter() - t0))
-    return out
+    try:
+        from distributed import get_worker
+        where = get_worker().address
+    except (ImportError, ValueError):
+        where = None
+    return ident, where, out
 
 
 def warm_up(runner_path=None):
@@ -182,13 +226,16 @@ def warm_up(runner_path=None):
     engine is a fingerprint of that case's numbers (12 hex digits of the SHA-1 of its
     answer less the wall time): it changes whenever the model's numbers do, which the
     version and GUID need not (a change of the numerics keeps the variables)."""
-    r = _runner(runner_path).run("duration=0.2", "warm-up")
+    r = _runner(runner_path).run("duration=0.2", "warm-up", limit=120.0)
     if r.get("error"):
         raise RuntimeError(f"the case runner {runner_path or default_runner()} fails: {r['error']}")
     numbers = {k: v for k, v in r.items() if k not in ("wall_s", "warnings")}
     import hashlib
     engine = hashlib.sha1(json.dumps(numbers, sort_keys=True).encode()).hexdigest()[:12]
-    return (r.get("version"), r.get("guid"), engine), r["wall_s"] / 0.2
+    ident = (r.get("version"), r.get("guid"), engine)
+    with _LOCK:
+        _IDENTITIES[runner_path or default_runner()] = ident
+    return ident, r["wall_s"] / 0.2
 
 
 def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
@@ -202,6 +249,8 @@ def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
     load_done.other = 0
     path = os.path.join(out_dir, "cases.jsonl")
     done = {}
+    # Ids whose latest record is another model's (a newer record of the id replaces it).
+    other = set()
     if os.path.exists(path):
         with open(path, encoding="utf-8", errors="replace") as fh:
             for line in fh:
@@ -212,16 +261,20 @@ def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
                 if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)
                         and isinstance(rec.get("result"), dict)):
                     continue
-                res = rec["result"]
+                cid, res = rec["id"], rec["result"]
                 if res.get("error") and (res.get("transient") or retry_failed):
-                    done.pop(rec["id"], None)
+                    done.pop(cid, None)
+                    other.discard(cid)
                     continue
-                if ident is not None and res.get("version") is not None \
-                        and (res.get("version"), res.get("guid"), rec.get("engine")) != tuple(ident):
-                    done.pop(rec["id"], None)
-                    load_done.other += 1
+                # Every record names the model that made it (failures too); one without
+                # (written before the identities were kept) counts as another's.
+                if ident is not None and tuple(rec.get("identity") or ()) != tuple(ident):
+                    done.pop(cid, None)
+                    other.add(cid)
                     continue
-                done[rec["id"]] = True if ids_only else rec
+                done[cid] = True if ids_only else rec
+                other.discard(cid)
+    load_done.other = len(other)
     return done
 
 
@@ -293,7 +346,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     ready = time.perf_counter()
     if total > have:
         if serial:
-            _serial(todo, total - have, out_dir, runner_path, progress, limit, ident[2])
+            _serial(todo, total - have, out_dir, runner_path, progress, limit)
         else:
             ready = _dask(todo, total - have, out_dir, runner_path, scheduler, workers, chunk, progress, limit,
                           ident)
@@ -312,9 +365,11 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     return table, total - have
 
 
-def _record(cid, res, wall, case, engine):
+def _record(cid, res, wall, case, ident):
+    """A line of cases.jsonl; `ident`: the (version, GUID, engine) of the runner that
+    answered."""
     return {"id": cid, "params": case.params, "duration": case.duration, "keep": list(case.keep),
-            "result": res, "wall_s": wall, "engine": engine}
+            "result": res, "wall_s": wall, "identity": list(ident)}
 
 
 def _bar(total, progress):
@@ -324,12 +379,12 @@ def _bar(total, progress):
     return tqdm(total=total, unit="case", file=sys.stderr)
 
 
-def _serial(todo, count, out_dir, runner_path, progress, limit, engine):
+def _serial(todo, count, out_dir, runner_path, progress, limit):
     """Runs the `count` cases of the iterator `todo` here, in order."""
     bar = _bar(count, progress)
     for case in todo:
-        [(cid, res, wall)] = run_chunk([(case.id, case.line(), limit(case))], runner_path)
-        _append(out_dir, [_record(cid, res, wall, case, engine)])
+        ident, _, [(cid, res, wall)] = run_chunk([(case.id, case.line(), limit(case))], runner_path)
+        _append(out_dir, [_record(cid, res, wall, case, ident)])
         if bar:
             bar.update(1)
     if bar:
@@ -343,8 +398,8 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
     if scheduler:
         try:
             client = Client(scheduler, timeout=60)
-        except OSError as e:
-            raise RuntimeError(f"cannot reach the scheduler {scheduler}: {e}") from None
+        except (OSError, ValueError, TypeError) as e:
+            raise RuntimeError(f"cannot reach the scheduler {scheduler}: {type(e).__name__}: {e}") from None
         cluster = None
         try:
             client.wait_for_workers(1, timeout=120)
@@ -364,6 +419,7 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
             answers = client.run(warm_up, runner_path)
         except Exception as e:
             raise RuntimeError(f"a worker cannot start its case runner: {type(e).__name__}: {e}") from None
+        # A worker with several threads runs a case in each, one runner per thread.
         other = {w: tuple(i) for w, (i, _) in answers.items() if tuple(i) != tuple(ident)}
         if other:
             raise RuntimeError("workers with another version, model GUID or engine than this one's (version "
@@ -379,8 +435,11 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
         pending = as_completed()
         flying = {}
 
+        requeued = []
+
         def send():
-            cases = list(itertools.islice(todo, size))
+            cases = [requeued.pop() for _ in range(min(size, len(requeued)))]
+            cases += list(itertools.islice(todo, size - len(cases)))
             if cases:
                 fut = client.submit(run_chunk, [(c.id, c.line(), limit(c)) for c in cases], runner_path,
                                     pure=False)
@@ -390,16 +449,44 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
         for _ in range(4 * nworkers):
             send()
         bar = _bar(count, progress)
+        retired, succeeded, failures = set(), False, []
         for fut in pending:
             cases = {c.id: c for c in flying.pop(fut.key)}
             try:
-                results = fut.result()
+                wid, where, results = fut.result()
             except Exception as e:  # a lost worker or task: its cases run again next time
+                wid, where = ident, None
                 results = [(cid, {"error": f"{type(e).__name__}: {e}", "transient": True}, 0.0)
                            for cid in cases]
+                failures.append(f"{type(e).__name__}: {e}")
+                # Tasks that fail before any succeeds (a scheduler or workers that cannot
+                # load them): stop, rather than record the whole study as lost.
+                if not succeeded and len(failures) >= 3:
+                    raise RuntimeError(f"the cluster fails every task ({failures[0][:300]}): is the wheelflat "
+                                       f"package installed where the scheduler and the workers run?")
+            else:
+                succeeded = True
+            if tuple(wid) != tuple(ident):
+                # A worker that joined after the start with another model: its answers
+                # are not kept, it is sent away and its cases run again on the others.
+                requeued.extend(cases.values())
+                results = []
+                if where is not None and where not in retired:
+                    retired.add(where)
+                    print(f"worker {where} runs another model (version {wid[0]}, GUID {wid[1]}, engine "
+                          f"{wid[2]}; this study's: {ident[0]}, {ident[1]}, {ident[2]}): retired, its cases "
+                          f"run elsewhere", file=sys.stderr)
+                    try:
+                        client.retire_workers(workers=[where], close_workers=True)
+                    except Exception:
+                        pass
+                wid = ident
             fut.release()
-            _append(out_dir, [_record(cid, res, wall, cases[cid], ident[2]) for cid, res, wall in results])
+            if results:
+                _append(out_dir, [_record(cid, res, wall, cases[cid], wid) for cid, res, wall in results])
             send()
+            if requeued and not flying:
+                send()
             if bar:
                 bar.update(len(results))
         if bar:

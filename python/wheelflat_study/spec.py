@@ -139,7 +139,7 @@ def _number(where, v):
 
 
 def _unit(where, unit):
-    if unit not in UNITS:
+    if not (unit is None or isinstance(unit, str)) or unit not in UNITS:
         raise ValueError(f"{where}: unit `{unit}`; known: {', '.join(sorted(u for u in UNITS if u))}")
     return unit
 
@@ -158,6 +158,8 @@ def _values(name, entry):
         unit = _unit(where, entry.get("unit"))
         if "values" in entry:
             values = entry["values"]
+            if not isinstance(values, list):
+                raise ValueError(f"{where}: values = {values!r}: a list of numbers")
         elif "range" in entry:
             r = entry["range"]
             if not isinstance(r, list) or len(r) != 3:
@@ -255,11 +257,17 @@ def load_study(path):
             raise ValueError(f"plot {i + 1}: name = `{pname}`: letters, digits, '_', '.', '-' (it names a file "
                              f"in the results folder)")
         kind = p.get("kind", "lines")
-        if kind not in PLOT_KINDS or set(p) - PLOT_KEYS:
+        if not isinstance(kind, str) or kind not in PLOT_KINDS or set(p) - PLOT_KEYS:
             raise ValueError(f"plot {i + 1}: kind one of {sorted(PLOT_KINDS)}, keys {sorted(PLOT_KEYS)}")
         missing = [k for k in PLOT_KINDS[kind] if k not in p]
         if missing:
             raise ValueError(f"plot {i + 1} ({kind}): needs {missing}")
+        for key in ("x", "y", "z", "by", "label", "title"):
+            if key in p and not isinstance(p[key], str):
+                raise ValueError(f"plot {i + 1}: {key} = {p[key]!r}: a column name or text, in quotes")
+        if "scale" in p and not (isinstance(p["scale"], (int, float)) and not isinstance(p["scale"], bool)
+                                 and math.isfinite(p["scale"]) and p["scale"] != 0):
+            raise ValueError(f"plot {i + 1}: scale = {p['scale']!r}: a finite number other than 0")
     study = Study(name=name, duration=duration, fixed=fixed, sweep=sweep, combine=combine,
                   keep=tuple(keep), plots=plots, display=display)
     if study.count() > MAX_CASES:

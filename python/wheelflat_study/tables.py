@@ -58,7 +58,7 @@ def write_tables(study, cases, done, out_dir):
         row["version"] = res.get("version", "")
         row["guid"] = res.get("guid", "")
         # The engine's fingerprint: changes with the model's numbers (run.warm_up).
-        row["engine"] = rec.get("engine", "")
+        row["engine"] = (rec.get("identity") or ["", "", ""])[2]
         row["runner_wall_s"] = res.get("wall_s")
         row["wall_s"] = rec.get("wall_s")
         versions.add(row["version"])
