@@ -73,19 +73,23 @@ fn track_contact_forces_are_direct_feedthrough() {
     inst.get_real(&[force, overlap], &mut p).unwrap();
     let (p0, d0) = (p[0], p[1]);
     // Lower the wheel by 0.1 um: the force rises at once (no step in between), by the
-    // contact stiffness dP/d(delta) = 3/2 P / delta of the small-overlap law.
+    // contact stiffness dP/d(delta) = 3/2 P / delta of the small-overlap law. The
+    // overlap rises by 1 / (1 + c k) of it: the rail under the wheel gives way by the
+    // rest through its local compliance c between nodes (docs/MODEL.md), at most
+    // dx / (4 kAG), 13 % of the contact's at the static load on table 4.4's track.
     let mut zs = [0.0];
     inst.get_real(&[z], &mut zs).unwrap();
     let dz = 1e-7;
     inst.set_real(&[z], &[zs[0] - dz]).unwrap();
     inst.get_real(&[force, overlap], &mut p).unwrap();
+    let rise = p[1] - d0;
     assert!(
-        (p[1] - (d0 + dz)).abs() < 1e-12,
+        rise <= dz * (1.0 + 1e-6) && rise > dz / 1.14,
         "overlap {} -> {}",
         d0,
         p[1]
     );
-    let expected = 1.5 * p0 / d0 * dz;
+    let expected = 1.5 * p0 / d0 * rise;
     assert!(
         ((p[0] - p0) - expected).abs() < 0.02 * expected,
         "{p0} -> {} (expected +{expected})",
