@@ -238,24 +238,28 @@ def warm_up(runner_path=None):
     return ident, r["wall_s"] / 0.2
 
 
-def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
+def load_done(out_dir, retry_failed=False, ident=None, ids_only=False, offsets=False):
     """The results already in the study's folder, by case id. Lines that are not a
     whole record (cut by an interruption, or damaged) are skipped, so their cases run
     again; so do cases that failed for a passing reason (a stopped runner, a lost
     worker), with `retry_failed` every failed case, and, given `ident` (version, GUID,
     engine fingerprint), results of another software version, GUID or engine (one
-    table holds one model's results); `load_done.other` counts those. ids_only: the records' ids only (what a
-    start needs; a million records' parameters would not fit in the memory a start has)."""
+    table holds one model's results); `load_done.other` counts those. ids_only: the
+    records' ids only (what a start needs; a million records' parameters would not fit
+    in the memory a start has); offsets: where each record starts in cases.jsonl
+    (bytes), for reading them one at a time."""
     load_done.other = 0
     path = os.path.join(out_dir, "cases.jsonl")
     done = {}
     # Ids whose latest record is another model's (a newer record of the id replaces it).
     other = set()
     if os.path.exists(path):
-        with open(path, encoding="utf-8", errors="replace") as fh:
+        with open(path, "rb") as fh:
+            at = 0
             for line in fh:
+                start, at = at, at + len(line)
                 try:
-                    rec = json.loads(line)
+                    rec = json.loads(line.decode("utf-8", errors="replace"))
                 except json.JSONDecodeError:
                     continue
                 if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)
@@ -272,7 +276,7 @@ def load_done(out_dir, retry_failed=False, ident=None, ids_only=False):
                     done.pop(cid, None)
                     other.add(cid)
                     continue
-                done[cid] = True if ids_only else rec
+                done[cid] = start if offsets else True if ids_only else rec
                 other.discard(cid)
     load_done.other = len(other)
     return done
@@ -355,7 +359,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     if total > have:
         log(f"ran {total - have} cases in {elapsed:.2f} s ({60 * (total - have) / elapsed:.0f} cases per minute)")
     from .tables import write_tables
-    table = write_tables(study, study.iter_cases(), load_done(out_dir, ident=ident), out_dir)
+    table = write_tables(study, out_dir, ident)
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:

@@ -32,57 +32,136 @@ def _flatten(res):
     return row
 
 
-def write_tables(study, cases, done, out_dir):
-    """Writes results.parquet/.csv and impacts.parquet/.csv; returns the results table
-    (a pandas DataFrame, the cases in study order, those not run left out)."""
+# Columns that hold text; every other column is a float64 (an impact's `k` an int64).
+TEXT = ("case_id", "status", "error", "warnings", "version", "guid", "engine", "wheel")
+# Rows a batch of the tables holds: the tables are written a batch at a time, so the
+# memory they take does not grow with the study.
+BATCH = 20_000
+
+
+def _rows(case, rec):
+    """The results row and the impacts rows of `case` from its record `rec`."""
+    res = rec["result"]
+    row = {"case_id": case.id}
+    row.update(case.params)
+    row["duration"] = case.duration
+    row["status"] = "error" if res.get("error") else "ok"
+    row["error"] = res.get("error") or ""
+    # The FMU's warnings (the case ran, but read them: near a fixed rail end, say);
+    # a column to filter on.
+    row["warnings"] = " | ".join(res.get("warnings") or [])
+    row.update(_flatten(res))
+    row["version"] = res.get("version", "")
+    row["guid"] = res.get("guid", "")
+    # The engine's fingerprint: changes with the model's numbers (run.warm_up).
+    row["engine"] = (rec.get("identity") or ["", "", ""])[2]
+    row["runner_wall_s"] = res.get("wall_s")
+    row["wall_s"] = rec.get("wall_s")
+    impacts = []
+    for m in res.get("impacts") or []:
+        imp = {"case_id": case.id}
+        imp.update(case.params)
+        imp.update(m)
+        impacts.append(imp)
+    return row, impacts
+
+
+def write_tables(study, out_dir, ident=None):
+    """Writes results.parquet/.csv and impacts.parquet/.csv from the records in
+    `out_dir`'s cases.jsonl of the study's cases (in the study's order; cases without a
+    record are left out) and of the model `ident`; returns the results
+    table (a pandas DataFrame read back from results.parquet). The records are read a
+    batch of rows at a time, twice (the columns first, then the rows), so the memory
+    this takes is that of a batch and of the returned table's columns, not of the
+    records."""
     import pandas as pd
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    rows, impacts = [], []
-    versions, guids = set(), set()
-    for c in cases:
-        rec = done.get(c.id)
-        if rec is None:
-            continue
-        res = rec["result"]
-        row = {"case_id": c.id}
-        row.update(c.params)
-        row["duration"] = c.duration
-        row["status"] = "error" if res.get("error") else "ok"
-        row["error"] = res.get("error") or ""
-        # The FMU's warnings (the case ran, but read them: near a fixed rail end, say);
-        # a column to filter on.
-        row["warnings"] = " | ".join(res.get("warnings") or [])
-        row.update(_flatten(res))
-        row["version"] = res.get("version", "")
-        row["guid"] = res.get("guid", "")
-        # The engine's fingerprint: changes with the model's numbers (run.warm_up).
-        row["engine"] = (rec.get("identity") or ["", "", ""])[2]
-        row["runner_wall_s"] = res.get("wall_s")
-        row["wall_s"] = rec.get("wall_s")
+    from .run import load_done
+    offsets = load_done(out_dir, ident=ident, offsets=True)
+    path = os.path.join(out_dir, "cases.jsonl")
+
+    def records():
+        with open(path, "rb") as fh:
+            for c in study.iter_cases():
+                at = offsets.get(c.id)
+                if at is not None:
+                    fh.seek(at)
+                    yield c, json.loads(fh.readline().decode("utf-8", errors="replace"))
+
+    # First pass: the columns, in the order a table of every row would have them, and
+    # the versions and GUIDs.
+    columns, impact_columns, versions, guids = {}, {}, set(), set()
+    for c, rec in records():
+        row, impacts = _rows(c, rec)
+        columns.update(dict.fromkeys(row))
+        for imp in impacts:
+            impact_columns.update(dict.fromkeys(imp))
         versions.add(row["version"])
         guids.add(row["guid"])
-        rows.append(row)
-        for m in res.get("impacts") or []:
-            imp = {"case_id": c.id}
-            imp.update(c.params)
-            imp.update(m)
-            impacts.append(imp)
-    table = pd.DataFrame(rows)
     meta = {b"wheelflat.study": study.name.encode(),
             b"wheelflat.version": json.dumps(sorted(v for v in versions if v)).encode(),
             b"wheelflat.guid.CoupledSystem": json.dumps(sorted(g for g in guids if g)).encode(),
             b"wheelflat.sweep": json.dumps(list(study.sweep)).encode()}
-    for name, df in (("results", table), ("impacts", pd.DataFrame(impacts))):
-        t = pa.Table.from_pandas(df, preserve_index=False)
-        t = t.replace_schema_metadata({**(t.schema.metadata or {}), **meta})
+
+    def schema(names):
+        fields = [pa.field(n, pa.string() if n in TEXT else pa.int64() if n == "k" else pa.float64())
+                  for n in names]
+        return pa.schema(fields, metadata=meta)
+
+    tables = {"results": (list(columns), schema(columns)), "impacts": (list(impact_columns), schema(impact_columns))}
+    writers, parts = {}, []
+    try:
+        for name, (names, sch) in tables.items():
+            for ext in ("parquet", "csv"):
+                parts.append(os.path.join(out_dir, f"{name}.{ext}.part"))
+            writers[name] = (pq.ParquetWriter(os.path.join(out_dir, f"{name}.parquet.part"), sch),
+                             open(os.path.join(out_dir, f"{name}.csv.part"), "w", newline=""))
+        batch = {"results": [], "impacts": []}
+        header = {"results": True, "impacts": True}
+
+        def flush(name):
+            names, sch = tables[name]
+            df = pd.DataFrame(batch[name], columns=names)
+            for n in names:
+                if n not in TEXT and n != "k":
+                    df[n] = df[n].astype("float64")
+            writers[name][0].write_table(pa.Table.from_pandas(df, schema=sch, preserve_index=False))
+            df.to_csv(writers[name][1], index=False, header=header[name], float_format="%.17g")
+            header[name] = False
+            batch[name] = []
+
+        # Second pass: the rows, a batch at a time.
+        for c, rec in records():
+            row, impacts = _rows(c, rec)
+            batch["results"].append(row)
+            batch["impacts"].extend(impacts)
+            for name in batch:
+                if len(batch[name]) >= BATCH:
+                    flush(name)
+        for name in batch:
+            if batch[name] or header[name]:
+                flush(name)
+        for pw, fh in writers.values():
+            pw.close()
+            fh.close()
         # Each table whole or not at all: written beside, then renamed over the old one
         # (a full disk left results.csv cut mid-number, which pandas read without a word).
-        _atomic(os.path.join(out_dir, f"{name}.parquet"), lambda p: pq.write_table(t, p))
-        _atomic(os.path.join(out_dir, f"{name}.csv"),
-                lambda p: df.to_csv(p, index=False, float_format="%.17g"))
-    return table
+        for part in parts:
+            os.replace(part, part[:-len(".part")])
+    except BaseException:
+        for pw, fh in writers.values():
+            try:
+                pw.close()
+            except Exception:
+                pass
+            fh.close()
+        for part in parts:
+            if os.path.exists(part):
+                os.remove(part)
+        raise
+    return pd.read_parquet(os.path.join(out_dir, "results.parquet"))
 
 
 def _atomic(path, write):
