@@ -135,20 +135,10 @@ fn near_flats(wheel: &FlattedWheel, gamma: f64, aw: f64) -> ([(f64, usize); MAX_
 /// delta`, the integrand vanishes at every contact edge, so the edges' motion adds
 /// nothing and `dP / d delta = K_w * (the total angle of the compressed springs)`, the
 /// sum of the contact intervals' widths (`2 K_w alpha_w` on a round wheel, from (2.5)).
-/// 0 out of contact. The intervals are found as [`adaptive`] finds them.
+/// 0 out of contact. The intervals are found as [`adaptive`] finds them: this is
+/// [`adaptive_and_stiffness`]'s stiffness, the state left aside.
 pub fn adaptive_stiffness(kw: f64, wheel: &WheelProfile, gamma: f64, overlap: f64) -> f64 {
-    let WheelProfile::Flatted(wheel) = wheel;
-    let rw = wheel.radius();
-    if overlap <= 0.0 || overlap.is_nan() {
-        return 0.0;
-    }
-    let delta = overlap.min(rw);
-    let (aw, _, _) = perfect_patch_scaled(delta * wheel.half_inv_radius());
-    let (near, nf) = near_flats(wheel, gamma, aw);
-    if nf == 0 {
-        return 2.0 * kw * aw;
-    }
-    kw * adaptive_flats_body(kw, wheel, &near[..nf], overlap, delta, aw, false).1
+    adaptive_and_stiffness(kw, wheel, gamma, overlap, &mut ContactState::default()).0
 }
 
 /// The adaptive integral when flats reach into the patch `[-aw, aw]` (rad) at overlap
@@ -178,8 +168,8 @@ fn adaptive_flats(
 }
 
 /// [`adaptive_flats`], inlined into each instruction set's copy; with the total angle
-/// of the compressed springs (rad), for [`adaptive_stiffness`] (unused, and so
-/// compiled away, in the force's copies).
+/// of the compressed springs (rad), the stiffness's (the contact's series solve and
+/// [`adaptive_stiffness`] use it; [`adaptive`] drops it).
 #[inline(always)]
 fn adaptive_flats_body(
     kw: f64,
