@@ -146,13 +146,27 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
-LOSING_RUNNER = """#!{python}
+# The start of every stand-in runner below: the real runner as a child, `--variables`
+# passed through; each stand-in's own loop over the case lines follows.
+FAKE_RUNNER_START = """#!{python}
 import subprocess, sys
 child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
                          bufsize=1)
 if sys.argv[1:]:
     sys.stdout.write(child.communicate()[0])
     sys.exit(0)
+"""
+
+
+def fake_runner(path, runner, loop):
+    """Writes an executable stand-in for the case runner at `path`: the real `runner`
+    behind `loop` (Python, reading `sys.stdin` and writing to `child`); its path."""
+    path.write_text(FAKE_RUNNER_START.format(python=sys.executable, runner=runner) + loop)
+    path.chmod(0o755)
+    return path
+
+
+LOSING_RUNNER = """\
 for line in sys.stdin:
     if "speed=30" in line:
         sys.exit(9)   # a runner killed on this case: no answer
@@ -167,8 +181,7 @@ def test_a_case_without_a_result_is_a_failure_and_runs_next_time(tmp_path, runne
     # Issue 26 item 1: killed runners' cases were left out with "195 of 200 cases, 0
     # failed" and exit status 0.
     losing = tmp_path / "losing_runner"
-    losing.write_text(LOSING_RUNNER.format(python=sys.executable, runner=runner))
-    losing.chmod(0o755)
+    fake_runner(losing, runner, LOSING_RUNNER)
     p = tmp_path / "lost.toml"
     p.write_text('name = "lost"\nduration = 0.01\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
@@ -395,8 +408,7 @@ def test_every_answer_names_its_case_and_a_shifted_answer_lands_on_no_case(tmp_p
     # A runner that answers each case with the previous case's answer (its first
     # answer for a case nobody asked): no answer lands on a case it is not for.
     shifted = tmp_path / "shifted_runner"
-    shifted.write_text(SHIFTED_RUNNER.format(python=sys.executable, runner=runner))
-    shifted.chmod(0o755)
+    fake_runner(shifted, runner, SHIFTED_RUNNER)
     p = tmp_path / "shift.toml"
     p.write_text('name = "shift"\nduration = 0.05\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
@@ -420,13 +432,8 @@ def test_every_answer_names_its_case_and_a_shifted_answer_lands_on_no_case(tmp_p
         assert alone["peak"]["left"] == peak
 
 
-SHIFTED_RUNNER = """#!{python}
-import json, subprocess, sys
-child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                         bufsize=1)
-if sys.argv[1:]:
-    sys.stdout.write(child.communicate()[0])
-    sys.exit(0)
+SHIFTED_RUNNER = """\
+import json
 before = None
 for line in sys.stdin:
     child.stdin.write(line)
@@ -440,13 +447,8 @@ for line in sys.stdin:
     sys.stdout.flush()
 """
 
-STALLING_RUNNER = """#!{python}
-import subprocess, sys, time
-child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                         bufsize=1)
-if sys.argv[1:]:
-    sys.stdout.write(child.communicate()[0])
-    sys.exit(0)
+STALLING_RUNNER = """\
+import time
 for line in sys.stdin:
     if "speed=25.0" in line:
         time.sleep(3600)   # a case that stalls
@@ -460,8 +462,7 @@ for line in sys.stdin:
 def test_a_case_past_its_time_limit_fails_alone_and_the_study_goes_on(tmp_path, runner, monkeypatch):
     # Issue 26 item 13: one case could stall a study for hours.
     stalling = tmp_path / "stalling_runner"
-    stalling.write_text(STALLING_RUNNER.format(python=sys.executable, runner=runner))
-    stalling.chmod(0o755)
+    fake_runner(stalling, runner, STALLING_RUNNER)
     p = tmp_path / "stall.toml"
     p.write_text('name = "stall"\nduration = 0.02\n[sweep]\nspeed = [20.0, 25.0, 30.0]\n')
     env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
@@ -614,18 +615,13 @@ def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_witho
     assert comparable(remote).equals(comparable(serial))
 
 
-OTHER_ENGINE_RUNNER = """#!{python}
-import json, subprocess, sys
-child = subprocess.Popen([{runner!r}] + sys.argv[1:], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-                         bufsize=1)
-if sys.argv[1:]:
-    sys.stdout.write(child.communicate()[0])
-    sys.exit(0)
+OTHER_ENGINE_RUNNER = """\
+import json
 for line in sys.stdin:
     child.stdin.write(line)
     child.stdin.flush()
     answer = json.loads(child.stdout.readline())
-    for k in answer.get("peak") or {{}}:
+    for k in answer.get("peak") or {}:
         answer["peak"][k] *= 1.5      # another engine: same version and GUID, other numbers
     sys.stdout.write(json.dumps(answer) + "\\n")
     sys.stdout.flush()
@@ -642,8 +638,7 @@ def test_a_worker_that_joins_later_with_another_engine_is_retired_and_its_cases_
                     ignore=shutil.ignore_patterns("__pycache__", "_data"))
     fake = pkg_b / "wheelflat_study" / "_data" / "bin" / "wheelflat_case"
     fake.parent.mkdir(parents=True)
-    fake.write_text(OTHER_ENGINE_RUNNER.format(python=sys.executable, runner=runner))
-    fake.chmod(0o755)
+    fake_runner(fake, runner, OTHER_ENGINE_RUNNER)
     p = tmp_path / "late.toml"
     p.write_text('name = "late"\nduration = 0.05\n[sweep]\nstart_position = { range = [3.0, 6.99, 0.01] }\n')
     port = _free_port()
@@ -729,3 +724,20 @@ def test_writing_the_tables_takes_memory_in_proportion_to_a_batch_not_to_the_rec
         peak[n] = int(r.stdout.split()[-1])
     grown_per_case = (peak[40_000] - peak[10_000]) * 1024 / 30_000
     assert grown_per_case < 3_000, f"{grown_per_case:.0f} bytes a case"
+
+
+def test_the_fast_case_ids_are_the_cases_own():
+    # Study.iter_cases builds each id from precomputed parts (about 2 us a case); it
+    # must give Case.id's own hash, or a resumed study would run every case again.
+    from wheelflat_study.spec import Case, Study
+    studies = [Study("a", 0.5, {"speed": 27.0, "a.b": 1e-5},
+                     {"flat.left[1].depth": [0.001, 0.0, 1e300], "start_position": [3.0, 4.5]},
+                     keep=("primary.left.force", "rail.left.z")),
+               Study("b", 0.12, {}, {"speed": [1.0, 2.0]}, combine="zip"),
+               Study("c", 1e-3, {"speed": 3.0}, {}),
+               Study("d", 0.5, {}, {})]
+    for s in studies:
+        cases = list(s.iter_cases())
+        assert len(cases) == s.count()
+        for c in cases:
+            assert c.id == Case(c.params, c.duration, c.keep).id, (s.name, c.params)

@@ -3,12 +3,14 @@ existing scheduler), each worker with its own persistent case runner; results ke
 they come (``cases.jsonl``, so an interrupted study resumes), then the tables and plots.
 """
 
+import hashlib
 import itertools
 import json
 import os
 import select
 import subprocess
 import sys
+import threading
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -156,13 +158,12 @@ MAX_TIME_LIMIT = 1e6
 # One runner per (path, thread): a Dask worker with several threads runs a case in each.
 _RUNNERS = {}
 _IDENTITIES = {}
-_LOCK = __import__("threading").Lock()
+_LOCK = threading.Lock()
 
 
 def _runner(path):
     """The case runner of this thread (one per Dask worker thread); `path` None: this
     installation's own (on a cluster's worker: the worker's install)."""
-    import threading
     path = path or default_runner()
     if path is None:
         raise RuntimeError("no case runner on this worker: install the wheelflat package there "
@@ -230,12 +231,16 @@ def warm_up(runner_path=None):
     if r.get("error"):
         raise RuntimeError(f"the case runner {runner_path or default_runner()} fails: {r['error']}")
     numbers = {k: v for k, v in r.items() if k not in ("wall_s", "warnings")}
-    import hashlib
     engine = hashlib.sha1(json.dumps(numbers, sort_keys=True).encode()).hexdigest()[:12]
     ident = (r.get("version"), r.get("guid"), engine)
     with _LOCK:
         _IDENTITIES[runner_path or default_runner()] = ident
     return ident, r["wall_s"] / 0.2
+
+
+def described(ident):
+    """A runner's identity in words: "version V, GUID G, engine E"."""
+    return f"version {ident[0]}, GUID {ident[1]}, engine {ident[2]}"
 
 
 def load_done(out_dir, retry_failed=False, ident=None, ids_only=False, offsets=False):
@@ -331,12 +336,13 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     sent, so memory stays in proportion to the chunks in flight, not to the study."""
     started = time.perf_counter()
     study.check()
-    ident, cost = warm_up(runner_path or build_runner())
+    # The command built the runner already (build_runner); a library call without one
+    # takes this installation's, built only if there is none.
+    ident, cost = warm_up(runner_path or default_runner() or build_runner())
     done = set(load_done(out_dir, retry_failed, ident, ids_only=True))
     if load_done.other:
         log(f"{study.name}: {load_done.other} results of another software version, model GUID or engine in "
-            f"{out_dir} are set aside and run again (this runner: version {ident[0]}, GUID {ident[1]}, "
-            f"engine {ident[2]})")
+            f"{out_dir} are set aside and run again (this runner: {described(ident)})")
     total = study.count()
     have = sum(1 for c in study.iter_cases() if c.id in done) if done else 0
     log(f"{study.name}: {total} cases, {have} already done, {total - have} to run")
@@ -426,10 +432,9 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
         # A worker with several threads runs a case in each, one runner per thread.
         other = {w: tuple(i) for w, (i, _) in answers.items() if tuple(i) != tuple(ident)}
         if other:
-            raise RuntimeError("workers with another version, model GUID or engine than this one's (version "
-                               f"{ident[0]}, GUID {ident[1]}, engine {ident[2]}): "
-                               + ", ".join(f"{w}: version {v}, GUID {g}, engine {e}"
-                                           for w, (v, g, e) in other.items()))
+            raise RuntimeError(f"workers with another version, model GUID or engine than this one's "
+                               f"({described(ident)}): "
+                               + ", ".join(f"{w}: {described(i)}" for w, i in other.items()))
         ready = time.perf_counter()
         nworkers = max(1, len(answers))
         # Chunks of a few cases: the scheduler's cost per task is shared, and every
@@ -477,9 +482,8 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
                 results = []
                 if where is not None and where not in retired:
                     retired.add(where)
-                    print(f"worker {where} runs another model (version {wid[0]}, GUID {wid[1]}, engine "
-                          f"{wid[2]}; this study's: {ident[0]}, {ident[1]}, {ident[2]}): retired, its cases "
-                          f"run elsewhere", file=sys.stderr)
+                    print(f"worker {where} runs another model ({described(wid)}; this study's: "
+                          f"{described(ident)}): retired, its cases run elsewhere", file=sys.stderr)
                     try:
                         client.retire_workers(workers=[where], close_workers=True)
                     except Exception:
@@ -489,8 +493,6 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
             if results:
                 _append(out_dir, [_record(cid, res, wall, cases[cid], wid) for cid, res, wall in results])
             send()
-            if requeued and not flying:
-                send()
             if bar:
                 bar.update(len(results))
         if bar:
