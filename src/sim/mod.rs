@@ -19,7 +19,7 @@ mod wheelset;
 pub use clock::StepPlan;
 pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
-    TrailingWheelset, VehicleSpec, kmh,
+    TrailingWheelset, VehicleSpec, VoidedSleepers, kmh,
 };
 pub use simulation::{
     CONTACT_STIFFNESS_MARGIN, InputRates, Simulation, TrackState, VehicleState, default_dt,

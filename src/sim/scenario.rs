@@ -10,7 +10,7 @@
 //!   (it implies C_H ~ 1.0e10 N/m^1.5); the printed value is kept.
 
 use crate::contact::ContactModel;
-use crate::track::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
+use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
 use crate::vehicle::{
     HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
 };
@@ -105,6 +105,60 @@ pub struct Scenario {
     /// (its length follows from the window and the wheelsets; the track parameters'
     /// `spans` is ignored).
     pub window: Option<TrackWindow>,
+    /// Hanging (voided) sleepers of the discrete track; `None`: every sleeper on the
+    /// ballast.
+    pub voids: Option<VoidedSleepers>,
+}
+
+/// Sleepers in a row that hang from the rails with a gap above the ballast, which
+/// carries them only once the gap has closed and never pulls
+/// ([`crate::track::Track::set_sleeper_gaps`]; `docs/MODEL.md`, "Supports that lift").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VoidedSleepers {
+    /// Position along the line of the first (m): the sleeper nearest it.
+    pub position: f64,
+    /// How many, from the first in the direction of travel (1 to 100).
+    pub sleepers: usize,
+    /// The gap under each (m, 0 to 0.05).
+    pub gap: f64,
+}
+
+impl VoidedSleepers {
+    /// The gap under each sleeper of a track whose node 0 lies at `origin` (m, line
+    /// coordinates) with `ns` sleepers `spacing` (m) apart.
+    ///
+    /// Errors: `sleepers` outside 1 to 100 (`track.void.sleepers`), `position` not
+    /// finite (`track.void.position`), `gap` outside 0 to 0.05 m (`track.void.gap`).
+    pub fn gaps(&self, origin: f64, ns: usize, spacing: f64) -> crate::error::Result<Vec<f64>> {
+        if !(1..=100).contains(&self.sleepers) {
+            return Err(crate::error::out_of_range(
+                "track.void.sleepers",
+                self.sleepers as f64,
+                "0 <= track.void.sleepers <= 100 (0: none)",
+            ));
+        }
+        crate::error::finite("track.void.position", self.position, "m")?;
+        if !(0.0..=0.05).contains(&self.gap) {
+            return Err(crate::error::out_of_range(
+                "track.void.gap",
+                self.gap,
+                "0 m <= track.void.gap <= 0.05 m",
+            ));
+        }
+        // Sleepers lie at whole multiples of the spacing in line coordinates.
+        let first = (self.position / spacing).round() as i64;
+        let node0 = (origin / spacing).round() as i64;
+        Ok((0..ns)
+            .map(|i| {
+                let k = node0 + i as i64 - first;
+                if (0..self.sleepers as i64).contains(&k) {
+                    self.gap
+                } else {
+                    0.0
+                }
+            })
+            .collect())
+    }
 }
 
 /// A wheelset behind the leading one.
@@ -171,6 +225,7 @@ fn table_4_track(spans: usize) -> TrackParams {
         sleeper_inertia: 90.0,
         ends: RailEnds::Fixed,
         between_nodes: RailBetweenNodes::Beam,
+        supports: Supports::default(),
     }
 }
 
@@ -207,6 +262,7 @@ impl Scenario {
             sites: Vec::new(),
             trailing: Vec::new(),
             window: None,
+            voids: None,
         }
     }
 
@@ -255,6 +311,7 @@ impl Scenario {
                 sleeper_inertia: 90.0,
                 ends: RailEnds::Fixed,
                 between_nodes: RailBetweenNodes::Beam,
+                supports: Supports::default(),
             }),
             vehicle: VehicleSpec::RollPlane(RollPlaneParams {
                 carbody_mass: 14702.0,
@@ -282,6 +339,7 @@ impl Scenario {
             sites: Vec::new(),
             trailing: Vec::new(),
             window: None,
+            voids: None,
         }
     }
 
@@ -309,6 +367,7 @@ impl Scenario {
             sleeper_inertia: 90.0,
             ends: RailEnds::Fixed,
             between_nodes: RailBetweenNodes::Beam,
+            supports: Supports::default(),
         });
         s.vehicle = VehicleSpec::RollPlane(RollPlaneParams {
             carbody_mass: 22135.0,
@@ -376,6 +435,7 @@ impl Scenario {
             sites: Vec::new(),
             trailing: Vec::new(),
             window: None,
+            voids: None,
         }
     }
 
@@ -415,6 +475,14 @@ impl Scenario {
     pub fn set_between_nodes(&mut self, b: RailBetweenNodes) {
         if let TrackSpec::Discrete(t) = &mut self.track {
             t.between_nodes = b;
+        }
+    }
+
+    /// Sets how a discrete track's pads and ballast carry load
+    /// ([`crate::track::SupportLaw::Linear`] is the thesis').
+    pub fn set_supports(&mut self, supports: Supports) {
+        if let TrackSpec::Discrete(t) = &mut self.track {
+            t.supports = supports;
         }
     }
 

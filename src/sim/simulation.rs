@@ -16,7 +16,9 @@ use crate::limits::{
     DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, MAX_WHEELSETS,
     MIN_DT_FRACTION, force_limit, within,
 };
-use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
+use crate::sim::{
+    DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec, VoidedSleepers,
+};
 use crate::track::{PointLoad, SimdLevel, Track, TrackParams};
 use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
@@ -251,6 +253,9 @@ pub struct Simulation {
     /// The first two wheelsets' axle boxes under the same side frames
     /// ([`crate::sim::SideFrameSpec::HalfCar`]).
     pub(super) shared_side_frames: bool,
+    /// The hanging sleepers ([`Scenario::voids`]), placed on the track anew whenever an
+    /// endless track's window moves.
+    pub(super) voids: Option<VoidedSleepers>,
 }
 
 /// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]).
@@ -582,7 +587,9 @@ impl Simulation {
             sites: Vec::new(),
             bogie,
             shared_side_frames,
+            voids: s.voids,
         };
+        sim.place_voids()?;
         sim.set_static()?;
         sim.check_static_sag()?;
         sim.check_states()?;
@@ -1180,8 +1187,37 @@ impl Simulation {
         t.shift_spans(m)?;
         w.origin_span += m as i64;
         self.origin = w.origin();
+        self.place_voids()?;
         self.clear_cache();
         Ok(())
+    }
+
+    /// Position along the line (m) of the sleeper of the longest lift of any support
+    /// since the start ([`Track::longest_lift`]); 0 when none has lifted.
+    pub fn longest_lift_position(&self) -> f64 {
+        match &self.track {
+            TrackState::Discrete(t) => match t.longest_lift() {
+                (0.0, _) => 0.0,
+                (_, i) => self.origin + i as f64 * t.params().sleeper_spacing,
+            },
+            TrackState::Lumped(_) => 0.0,
+        }
+    }
+
+    /// Puts the hanging sleepers ([`Scenario::voids`]) where they lie in the track as
+    /// it is now (an endless track's window moves over them).
+    pub(super) fn place_voids(&mut self) -> Result<()> {
+        let (Some(v), TrackState::Discrete(t)) = (&self.voids, &mut self.track) else {
+            if self.voids.is_some() {
+                return Err(Error::Unsupported(
+                    "hanging sleepers on the lumped track (it has no sleepers)".into(),
+                ));
+            }
+            return Ok(());
+        };
+        let p = t.params();
+        let gaps = v.gaps(self.origin, p.spans + 1, p.sleeper_spacing)?;
+        t.set_sleeper_gaps(&gaps)
     }
 
     /// Changes the time step to `dt` (s) from now on (track and vehicle keep their

@@ -1,6 +1,7 @@
 //! Observation points fixed in track coordinates: what the track feels there at every
 //! step (rail displacement, bending moment and shear force; at the nearest sleeper the
-//! rail seat force, the seat's displacement and the ballast force, for both rails),
+//! rail seat force, the seat's displacement and the ballast force, and how long the
+//! pad or the ballast has let go, for both rails),
 //! with the extremes since the start, so that a coarse output never hides a passing
 //! peak.
 
@@ -10,19 +11,25 @@ use crate::track::Track;
 
 /// The quantities recorded at a site for each rail, in the order of [`SiteValues`]:
 /// rail displacement (m), rail bending moment (N m), rail shear force (N), rail seat
-/// force (N), seat displacement (m), ballast force (N) (see
+/// force (N), seat displacement (m), ballast force (N), and how long the rail has been
+/// lifted off the pad and the seat off the ballast without a break (s) (see
 /// [`crate::track::RailResponse`] and [`crate::track::SupportResponse`]).
-pub const SITE_QUANTITIES: [&str; 6] = [
+pub const SITE_QUANTITIES: [&str; 8] = [
     "rail.z",
     "rail.bending_moment",
     "rail.shear_force",
     "seat.force",
     "seat.z",
     "ballast.force",
+    "seat.lifted",
+    "ballast.lifted",
 ];
 
+/// Number of [`SITE_QUANTITIES`].
+const NQ: usize = SITE_QUANTITIES.len();
+
 /// The values of [`SITE_QUANTITIES`] on the left (0) and right (1) rail.
-pub type SiteValues = [[f64; 6]; 2];
+pub type SiteValues = [[f64; NQ]; 2];
 
 /// One observation point: its position and what the track feels there.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,7 +64,7 @@ impl Site {
     fn read(track: &Track, origin: f64, x: f64) -> SiteValues {
         let x = x - origin;
         if !(x > 0.0 && x < track.params().length()) {
-            return [[0.0; 6]; 2];
+            return [[0.0; NQ]; 2];
         }
         [0, 1].map(|rail| {
             let r = track.rail_response(rail, x);
@@ -69,6 +76,8 @@ impl Site {
                 s.rail_seat_force,
                 s.seat_displacement,
                 s.ballast_force,
+                s.pad_lifted,
+                s.ballast_lifted,
             ]
         })
     }
@@ -77,7 +86,7 @@ impl Site {
     pub(crate) fn record(&mut self, track: &Track, origin: f64) {
         self.now = Self::read(track, origin, self.position);
         for rail in 0..2 {
-            for q in 0..6 {
+            for q in 0..NQ {
                 let x = self.now[rail][q];
                 self.max[rail][q] = self.max[rail][q].max(x);
                 self.min[rail][q] = self.min[rail][q].min(x);
@@ -91,7 +100,7 @@ impl Site {
     }
 
     /// Number of values [`Site::extremes`] yields.
-    pub(crate) const STATE_LEN: usize = 24;
+    pub(crate) const STATE_LEN: usize = 4 * NQ;
 
     /// Restores the extremes from [`Site::extremes`] and reads the track now.
     pub(crate) fn restore(&mut self, track: &Track, origin: f64, v: &[f64]) {

@@ -180,6 +180,7 @@ impl Simulation {
         if let Some(w) = &mut self.window {
             w.origin_span = origin_span as i64;
             self.origin = w.origin();
+            self.place_voids()?;
         }
         let c = &mut self.clock;
         (c.dt, c.t0, c.k) = (v[0], v[1], v[2] as u64);

@@ -306,7 +306,7 @@ fn a_site_records_what_the_track_feels_as_the_wheel_passes() {
         sim.step().unwrap();
         let now = sim.sites()[0].now();
         for rail in 0..2 {
-            for q in 0..6 {
+            for q in 0..crate::sim::SITE_QUANTITIES.len() {
                 seen_max[rail][q] = seen_max[rail][q].max(now[rail][q]);
                 seen_min[rail][q] = seen_min[rail][q].min(now[rail][q]);
             }

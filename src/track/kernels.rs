@@ -193,7 +193,8 @@ pub(super) fn stencil_body<const PAD: bool, const FMA: bool>(
 /// One track step's loops over phase-blocked arrays of `n` blocks (see [`Track`]):
 /// 1. pad forces at t_j (backward-difference damper velocities) and the sleeper
 ///    update (3.18), in place over the t_(j-1) sleeper arrays; block 0 holds the rail
-///    nodes above the sleepers;
+///    nodes above the sleepers; with supports that can lift, `unilateral`'s loop
+///    ([`sleepers_unilateral`]) in place of the vectorised one;
 /// 2. the rail stencil block by block, each whole, written in place over the t_(j-1)
 ///    rail arrays, the pad forces entering block 0 and its mask `keep` clearing the
 ///    rail ends and its padding. Block p's left neighbours are block p - 1 (block
@@ -216,16 +217,40 @@ pub(super) fn kernels_body<const FMA: bool>(
     keep: &[f64],
     c: &Coeffs,
     n: usize,
+    unilateral: Option<&mut Unilateral>,
 ) {
     let sp = zs.len();
+    {
+        let b0 = block_start(0, n, sp)..block_start(0, n, sp) + 2 * sp;
+        let (rl, rr) = z[b0.clone()].split_at(sp);
+        let (rlp, rrp) = z_prev[b0].split_at(sp);
+        let (pl, pr) = pad.split_at_mut(sp);
+        match unilateral {
+            None => sleepers_body::<FMA>(rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s),
+            Some(u) => sleepers_unilateral::<FMA>(
+                rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s, u,
+            ),
+        }
+    }
+    rail_body::<FMA>(z, th, z_prev, th_prev, pad, keep, c, n);
+}
+
+/// The rail stencil (3.12) over every phase block (see [`kernels_body`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn rail_body<const FMA: bool>(
+    z: &[f64],
+    th: &[f64],
+    z_prev: &mut [f64],
+    th_prev: &mut [f64],
+    pad: &[f64],
+    keep: &[f64],
+    c: &Coeffs,
+    n: usize,
+) {
+    let sp = keep.len() / 2;
     let b = 2 * sp;
     let block = |p: usize| block_start(p, n, sp)..block_start(p, n, sp) + b;
-    {
-        let (rl, rr) = z[block(0)].split_at(sp);
-        let (rlp, rrp) = z_prev[block(0)].split_at(sp);
-        let (pl, pr) = pad.split_at_mut(sp);
-        sleepers_body::<FMA>(rl, rr, rlp, rrp, zs, ph, zs_prev, ph_prev, pl, pr, &c.s);
-    }
     for p in 0..n {
         let centre = block(p);
         let left = if p == 0 {
@@ -274,6 +299,7 @@ pub(super) fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
         padding,
         ends_inner,
         slot,
+        unilateral,
         ..
     } = t;
     let sp = *sp;
@@ -285,7 +311,19 @@ pub(super) fn step_body<const FMA: bool>(t: &mut Track, loads: &[PointLoad]) {
     };
     // 1-2. Sleepers and pads, then the rail stencil (see `kernels_body`).
     kernels_body::<FMA>(
-        z, th, z_prev, th_prev, zs, ph, zs_prev, ph_prev, pad, keep, c, n,
+        z,
+        th,
+        z_prev,
+        th_prev,
+        zs,
+        ph,
+        zs_prev,
+        ph_prev,
+        pad,
+        keep,
+        c,
+        n,
+        unilateral.as_deref_mut(),
     );
     // 3. Wheel forces on the new rail state, the rail ends (which the loops left at
     // zero) excepted.

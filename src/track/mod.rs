@@ -24,6 +24,9 @@ mod state;
 mod static_solve;
 mod stepper;
 mod storage;
+mod supports;
+#[cfg(test)]
+mod supports_tests;
 #[cfg(test)]
 mod tests;
 mod window;
@@ -33,11 +36,13 @@ pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
 pub use stepper::{PointLoad, Track};
+pub use supports::{SupportLaw, Supports};
 
 // What the files of the track share (each begins with `use super::*`).
 use crate::error::{Error, Result, out_of_range, positive};
 use crate::limits::{MAX_NODES_PER_SPAN, MAX_RAIL_SEGMENTS, check};
-use crate::numerics::{LANES, inlined};
+use crate::numerics::{LANES, inlined, solve_banded_spd};
 use kernels::*;
 use nalgebra::{DMatrix, DVector, Matrix4, SymmetricEigen};
 use storage::*;
+use supports::*;

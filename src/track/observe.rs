@@ -37,8 +37,16 @@ pub struct SupportResponse {
     pub seat_displacement: f64,
     /// Ballast force under the rail seat (N), positive in compression:
     /// `-(K_b z_seat + C_b dz_seat/dt)`, the velocity a backward difference over the
-    /// last step.
+    /// last step; with supports that can lift, its limit while the seat is lifted
+    /// (`-track.ballast.preload`, 0 under a hanging sleeper) and the gap counted under
+    /// a hanging sleeper.
     pub ballast_force: f64,
+    /// How long the rail has been lifted off this pad without a break (s); 0 while the
+    /// pad carries.
+    pub pad_lifted: f64,
+    /// How long the seat has been lifted off the ballast without a break (s); 0 while
+    /// the ballast carries.
+    pub ballast_lifted: f64,
 }
 
 impl Track {
@@ -86,13 +94,33 @@ impl Track {
         let side = if rail == 0 { -1.0 } else { 1.0 };
         let seat = |zs: &[f64], ph: &[f64]| zs[i] + side * ls * ph[i];
         let (now, before) = (seat(&self.zs, &self.ph), seat(&self.zs_prev, &self.ph_prev));
+        let (pad_lifted, ballast_lifted) = self.lift_times(rail, i);
+        let ballast_off = self.lifted(rail, i).1;
+        let (gap, limit) = self
+            .unilateral
+            .as_ref()
+            .map_or((0.0, 0.0), |u| (u.gap[i], u.ballast_limit[i]));
         SupportResponse {
             sleeper: i,
             position: i as f64 * p.sleeper_spacing,
             rail_seat_force: self.pad_forces(rail)[i],
             seat_displacement: now,
-            ballast_force: -(p.ballast_stiffness * now
-                + p.ballast_damping * (now - before) / self.dt),
+            // With supports that can lift, the force the step's update found (its
+            // velocity a central difference) is at least the limit; the backward
+            // difference here may stray below it by a little.
+            ballast_force: if ballast_off {
+                -limit
+            } else {
+                let f = -(p.ballast_stiffness * (now + gap)
+                    + p.ballast_damping * (now - before) / self.dt);
+                if self.unilateral.is_some() {
+                    f.max(-limit)
+                } else {
+                    f
+                }
+            },
+            pad_lifted,
+            ballast_lifted,
         }
     }
 }

@@ -105,6 +105,10 @@ pub struct TrackParams {
     pub ends: RailEnds,
     /// The rail under a wheel between grid nodes.
     pub between_nodes: RailBetweenNodes,
+    /// How the rail pads and the ballast carry load: linear springs (the thesis) or
+    /// supports that carry no tension beyond a preload (`docs/MODEL.md`, "Supports
+    /// that lift").
+    pub supports: Supports,
 }
 
 impl TrackParams {
@@ -141,6 +145,7 @@ impl TrackParams {
         check("track.ballast.damping", self.ballast_damping)?;
         check("track.sleeper.mass", self.sleeper_mass)?;
         check("track.sleeper.inertia", self.sleeper_inertia)?;
+        self.supports.validate()?;
         Ok(())
     }
 

@@ -5,11 +5,13 @@ use super::*;
 impl Track {
     /// Number of values in [`Track::state_vector`].
     pub fn state_len(&self) -> usize {
-        1 + 8 * self.nk + 6 * self.ns
+        1 + 8 * self.nk + 6 * self.ns + self.unilateral.as_ref().map_or(0, |_| 4 * self.ns + 2)
     }
 
     /// Everything that determines the continuation: the step, rails (node order, both
-    /// rails end to end) and sleepers at t_j and t_(j-1), and the last pad forces.
+    /// rails end to end) and sleepers at t_j and t_(j-1), and the last pad forces;
+    /// with supports that can lift, how long each has been lifted and the longest
+    /// lift with its sleeper.
     /// [`Track::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = Vec::with_capacity(self.state_len());
@@ -23,6 +25,11 @@ impl Track {
         }
         v.extend_from_slice(&self.pad[..ns]);
         v.extend_from_slice(&self.pad[sp..sp + ns]);
+        if let Some(u) = &self.unilateral {
+            v.extend_from_slice(&u.pad_lifted);
+            v.extend_from_slice(&u.ballast_lifted);
+            v.extend([u.longest, u.longest_at as f64]);
+        }
         v
     }
 
@@ -63,6 +70,19 @@ impl Track {
             let (head, tail) = rest.split_at(ns);
             a.copy_from_slice(head);
             rest = tail;
+        }
+        if let Some(u) = &mut self.unilateral {
+            let (times, longest) = rest.split_at(4 * ns);
+            if let Some(&x) = times
+                .iter()
+                .chain(longest)
+                .find(|x| !(x.is_finite() && **x >= -1e15))
+            {
+                return Err(out_of_range("state: support lift times", x, "finite"));
+            }
+            u.pad_lifted.copy_from_slice(&times[..2 * ns]);
+            u.ballast_lifted.copy_from_slice(&times[2 * ns..]);
+            (u.longest, u.longest_at) = (longest[0], longest[1] as i64);
         }
         Ok(())
     }

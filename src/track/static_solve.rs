@@ -2,7 +2,6 @@
 //! the track) and the discrete energy.
 
 use super::*;
-use crate::numerics::solve_banded_spd;
 
 impl Track {
     /// Number of unknowns of the static problem.
@@ -24,7 +23,19 @@ impl Track {
 
     /// Every contribution `v` to entry `(i, j)` of [`Track::stiffness_matrix`], in one
     /// fixed order (so any assembly sums each entry's contributions alike).
-    pub(super) fn stiffness_entries(&self, mut add: impl FnMut(usize, usize, f64)) {
+    pub(super) fn stiffness_entries(&self, add: impl FnMut(usize, usize, f64)) {
+        self.stiffness_entries_with(None, add)
+    }
+
+    /// [`Track::stiffness_entries`] with only the supports that carry: `on` holds
+    /// whether each pad (the left rail's seats, then the right rail's) and each
+    /// ballast seat (the sleepers' left seats, then their right seats) carries; the
+    /// others add no stiffness. `None`: all carry, the linear track.
+    pub(super) fn stiffness_entries_with(
+        &self,
+        on: Option<(&[bool], &[bool])>,
+        mut add: impl FnMut(usize, usize, f64),
+    ) {
         let p = &self.params;
         let r = &p.rail;
         let dx = p.dx();
@@ -80,6 +91,9 @@ impl Track {
         for i in 0..ns {
             let node = i * p.nodes_per_span;
             for (rail, arm) in [(0usize, -ls), (1usize, ls)] {
+                if on.is_some_and(|(pads, _)| !pads[rail * ns + i]) {
+                    continue;
+                }
                 let g = rail * nk + node;
                 let rail_fixed = node == 0 || node == nk - 1;
                 // pad energy 1/2 K_p (Z - Z_s - arm phi)^2
@@ -94,8 +108,23 @@ impl Track {
                     }
                 }
             }
-            add(izs + i, izs + i, 2.0 * p.ballast_stiffness);
-            add(iph + i, iph + i, 2.0 * ls * ls * p.ballast_stiffness);
+            match on {
+                Some((_, ballast)) if !(ballast[i] && ballast[ns + i]) => {
+                    for (seat, arm) in [(0usize, -ls), (1usize, ls)] {
+                        if ballast[seat * ns + i] {
+                            let kb = p.ballast_stiffness;
+                            add(izs + i, izs + i, kb);
+                            add(izs + i, iph + i, kb * arm);
+                            add(iph + i, izs + i, kb * arm);
+                            add(iph + i, iph + i, kb * arm * arm);
+                        }
+                    }
+                }
+                _ => {
+                    add(izs + i, izs + i, 2.0 * p.ballast_stiffness);
+                    add(iph + i, iph + i, 2.0 * ls * ls * p.ballast_stiffness);
+                }
+            }
         }
     }
 
@@ -103,7 +132,7 @@ impl Track {
     /// with zero accelerations and velocities), solved directly.
     pub fn set_static(&mut self, loads: &[PointLoad]) -> Result<()> {
         let n = self.static_size();
-        let (nk, ns, sp) = (self.nk, self.ns, self.sp);
+        let nk = self.nk;
         let mut f = DVector::<f64>::zeros(n);
         for l in loads {
             let (kk, w) = self.locate(l.position);
@@ -113,6 +142,9 @@ impl Track {
                     f[base + node] -= share * l.force;
                 }
             }
+        }
+        if self.unilateral.is_some() {
+            return self.set_static_unilateral(f.as_slice());
         }
         let x = self.solve_static_banded(f.as_slice()).ok_or_else(|| {
             out_of_range(
@@ -127,7 +159,14 @@ impl Track {
                 ),
             )
         })?;
-        let xs = x.as_slice();
+        self.set_static_state(&x);
+        Ok(())
+    }
+
+    /// Sets the state at t_j and t_(j-1) to the static solution `x` (unknowns of
+    /// [`Track::stiffness_matrix`]), with the linear pad forces.
+    pub(super) fn set_static_state(&mut self, xs: &[f64]) {
+        let (nk, ns, sp) = (self.nk, self.ns, self.sp);
         Self::from_nodes(&self.slot, sp, &xs[..2 * nk], &mut self.z);
         Self::from_nodes(&self.slot, sp, &xs[2 * nk..4 * nk], &mut self.th);
         self.zs[..ns].copy_from_slice(&xs[4 * nk..4 * nk + ns]);
@@ -144,7 +183,6 @@ impl Track {
             self.pad[i] = -self.params.pad_stiffness * (zl - self.zs[i] + ls * self.ph[i]);
             self.pad[sp + i] = -self.params.pad_stiffness * (zr - self.zs[i] - ls * self.ph[i]);
         }
-        Ok(())
     }
 
     /// Unknowns of [`Track::stiffness_matrix`] in order along the track: at each node

@@ -87,6 +87,9 @@ pub struct Track {
     /// set over the interior nodes, none over the rail ends and the padding.
     pub(super) keep: Aligned,
     pub(super) simd: SimdLevel,
+    /// Supports that can lift ([`SupportLaw::Tensionless`] or a gap under a sleeper);
+    /// `None`: the thesis' linear supports.
+    pub(super) unilateral: Option<Box<Unilateral>>,
 }
 
 impl Track {
@@ -180,6 +183,8 @@ impl Track {
             pad: Aligned::zeros(2 * sp),
             keep,
             simd: SimdLevel::detect(),
+            unilateral: (params.supports.law == SupportLaw::Tensionless)
+                .then(|| Box::new(Unilateral::new(&params, ns, dt))),
         }
     }
 
@@ -296,6 +301,11 @@ impl Track {
         ] {
             v.iter_mut().for_each(|x| *x = 0.0);
         }
+        if let Some(u) = &mut self.unilateral {
+            u.pad_lifted.iter_mut().for_each(|t| *t = CARRIES);
+            u.ballast_lifted.iter_mut().for_each(|t| *t = CARRIES);
+            (u.longest, u.longest_at) = (0.0, 0);
+        }
     }
 
     /// Node index and shape-function weight for a position: the load at `x` goes
@@ -404,6 +414,9 @@ impl Track {
         }
         self.c = Coeffs::new(&self.params, dt);
         self.dt = dt;
+        if let Some(u) = &mut self.unilateral {
+            u.set_dt(&self.params, dt);
+        }
         Ok(())
     }
 }

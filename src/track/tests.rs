@@ -16,6 +16,7 @@ fn seed_track(spans: usize, n: usize) -> TrackParams {
         sleeper_inertia: 90.0,
         ends: RailEnds::Fixed,
         between_nodes: RailBetweenNodes::Beam,
+        supports: Supports::default(),
     }
 }
 

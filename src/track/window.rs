@@ -62,6 +62,20 @@ impl Track {
         for rail in 0..2 {
             shift_left(&mut self.pad[rail * sp..rail * sp + ns], m);
         }
+        // Supports that can lift: their lift times move with them (the gaps are the
+        // caller's to place anew, `Track::set_sleeper_gaps`).
+        if let Some(u) = &mut self.unilateral {
+            for a in [&mut u.pad_lifted, &mut u.ballast_lifted] {
+                for side in 0..2 {
+                    let part = &mut a[side * ns..(side + 1) * ns];
+                    shift_left(part, m);
+                    let len = part.len();
+                    part[len - m.min(len)..].fill(CARRIES);
+                }
+            }
+            shift_left(&mut u.gap, m);
+            u.longest_at -= m as i64;
+        }
         // The window's ends are fixed.
         for (end, _) in self.ends_inner {
             for a in [

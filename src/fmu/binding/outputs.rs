@@ -88,6 +88,14 @@ impl FmuModel {
             View::Sim(_, s) => f(&s.contact[side]),
             View::Vehicle(_) => f64::NAN,
         };
+        // The discrete track of a track-carrying model.
+        let lifted = |f: fn(&crate::track::Track) -> f64| match view {
+            View::Sim(sim, _) => match sim.track() {
+                crate::sim::TrackState::Discrete(t) => f(t),
+                crate::sim::TrackState::Lumped(_) => 0.0,
+            },
+            View::Vehicle(_) => f64::NAN,
+        };
         // The rail under this side's wheel of a track-carrying model.
         let rail = |f: fn(&RailResponse) -> f64| match view {
             View::Sim(sim, _) => sim
@@ -231,7 +239,19 @@ impl FmuModel {
             | Quantity::SiteSeatZMin
             | Quantity::SiteBallastForce
             | Quantity::SiteBallastForceMax
-            | Quantity::SiteBallastForceMin => f64::NAN,
+            | Quantity::SiteBallastForceMin
+            | Quantity::SiteSeatLifted
+            | Quantity::SiteSeatLiftedMax
+            | Quantity::SiteBallastLifted
+            | Quantity::SiteBallastLiftedMax => f64::NAN,
+            // Supports that lift, over the whole track.
+            Quantity::TrackLiftedPads => lifted(|t| t.lifted_supports().0 as f64),
+            Quantity::TrackLiftedBallast => lifted(|t| t.lifted_supports().1 as f64),
+            Quantity::TrackLiftedLongest => lifted(|t| t.longest_lift().0),
+            Quantity::TrackLiftedPosition => match view {
+                View::Sim(sim, _) => sim.longest_lift_position(),
+                View::Vehicle(_) => f64::NAN,
+            },
         }
     }
 }
@@ -261,6 +281,10 @@ fn site_value(engine: &Engine, q: Quantity, side: usize, index: usize) -> Option
         SiteBallastForce => (5, 0),
         SiteBallastForceMax => (5, 1),
         SiteBallastForceMin => (5, 2),
+        SiteSeatLifted => (6, 0),
+        SiteSeatLiftedMax => (6, 1),
+        SiteBallastLifted => (7, 0),
+        SiteBallastLiftedMax => (7, 1),
         _ => return None,
     };
     let Engine::Sim(sim) = engine else {

@@ -7,8 +7,10 @@ use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
 use crate::sim::VehicleUnitParams;
-use crate::sim::{Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec};
-use crate::track::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
+use crate::sim::{
+    Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
+};
+use crate::track::{RailBetweenNodes, RailEnds, RailSection, SupportLaw, Supports, TrackParams};
 use crate::vehicle::{HalfCarParams, RollPlaneParams};
 use crate::wheel::{FlatShape, FlatSpec};
 
@@ -38,6 +40,15 @@ pub fn track_params(v: &[f64]) -> TrackParams {
             RailBetweenNodes::Linear
         } else {
             RailBetweenNodes::Beam
+        },
+        supports: Supports {
+            law: if v(vr::TRACK_SUPPORTS) == enums::support_law::TENSIONLESS {
+                SupportLaw::Tensionless
+            } else {
+                SupportLaw::Linear
+            },
+            pad_preload: v(vr::TRACK_PAD_PRELOAD),
+            ballast_preload: v(vr::TRACK_BALLAST_PRELOAD),
         },
     }
 }
@@ -207,6 +218,11 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         window: (val(vr::TRACK_WINDOW_AHEAD) > 0.0).then(|| TrackWindow {
             ahead: val(vr::TRACK_WINDOW_AHEAD),
             behind: val(vr::TRACK_WINDOW_BEHIND),
+        }),
+        voids: (val(vr::TRACK_VOID_SLEEPERS) > 0.0).then(|| VoidedSleepers {
+            position: val(vr::TRACK_VOID_POSITION),
+            sleepers: val(vr::TRACK_VOID_SLEEPERS) as usize,
+            gap: val(vr::TRACK_VOID_GAP),
         }),
     }
 }

@@ -1,0 +1,487 @@
+//! Supports that lift: rail pads and ballast that carry no tension beyond a preload,
+//! and hanging (voided) sleepers with a gap between them and the ballast
+//! (`docs/MODEL.md`, "Supports that lift"). The thesis names the sleeper's tendency to
+//! lift off the ballast as future work (chapter 6).
+//!
+//! Every support is the thesis' spring and damper while it carries compression, or
+//! tension up to its preload; beyond that it lets go and carries the preload's
+//! tension only. A linear support has no limit, so with [`SupportLaw::Linear`] and no
+//! gaps the track is the thesis' (and steps through the vectorised loops of
+//! `kernels.rs`); otherwise the sleeper loop is this file's, the rail loops the same.
+
+use super::*;
+
+/// How the rail pads and the ballast carry load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SupportLaw {
+    /// Linear springs and dampers that pull as they push (the thesis, 3.6-3.9).
+    #[default]
+    Linear,
+    /// Pads and ballast that carry compression, and tension only up to their preload
+    /// ([`Supports::pad_preload`], [`Supports::ballast_preload`]): beyond it the rail
+    /// lifts off its pad, or the sleeper's seat off the ballast.
+    Tensionless,
+}
+
+/// The supports' law and preloads.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Supports {
+    /// Linear or tensionless.
+    pub law: SupportLaw,
+    /// Tension a rail pad carries before the rail lifts off it (N per rail seat, 0
+    /// or more): the fastening's clamping force (toe load) that compresses the pad at
+    /// rest, plus the rail's weight on the seat if it is to count (the model's
+    /// displacements are from the track's rest under its own weight). 0: the pad
+    /// lets go at any tension. Typical clips: 2 x 9 to 12 kN per seat.
+    pub pad_preload: f64,
+    /// Tension the ballast under a rail seat carries before the seat lifts off it (N,
+    /// 0 or more): the weight it carries at rest (half the sleeper's and a span of rail's,
+    /// 1.7 kN on table 4.4's track). 0: it lets go at any tension.
+    pub ballast_preload: f64,
+}
+
+impl Supports {
+    /// Checks both preloads (finite, >= 0, at most 1 MN).
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("track.pad.preload", self.pad_preload),
+            ("track.ballast.preload", self.ballast_preload),
+        ] {
+            if !(0.0..=1e6).contains(&v) {
+                return Err(out_of_range(name, v, "0 N <= value <= 1e6 N"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The lift time of a support that carries.
+pub(super) const CARRIES: f64 = -1.0;
+
+/// The state of supports that can lift: the gaps, the limits, and how long each
+/// support has been lifted.
+#[derive(Debug, Clone)]
+pub(super) struct Unilateral {
+    /// Gap between each sleeper and the ballast at rest (m), per sleeper; 0 on the
+    /// ballast.
+    pub(super) gap: Vec<f64>,
+    /// Tension a pad carries before it lets go (N); infinite with linear supports.
+    pub(super) pad_limit: f64,
+    /// Tension the ballast under each sleeper's seats carries before it lets go (N):
+    /// 0 under a hanging sleeper, the ballast preload with tensionless supports,
+    /// infinite with linear ones.
+    pub(super) ballast_limit: Vec<f64>,
+    /// Time each pad has been lifted without a break (s; 0 lifted at the static
+    /// start), [`CARRIES`] while it carries: the left rail's seats, then the right
+    /// rail's (`2 N_s`).
+    pub(super) pad_lifted: Vec<f64>,
+    /// Time each ballast seat has been lifted without a break (s), as the pads': the
+    /// sleepers' left seats, then their right seats (`2 N_s`).
+    pub(super) ballast_lifted: Vec<f64>,
+    /// The longest lift of any support since the start (s) and its sleeper (an index
+    /// of the track at the time, moved with an endless track's window).
+    pub(super) longest: f64,
+    pub(super) longest_at: i64,
+    /// Step (s), ballast stiffness (N/m), `C_b / (2 dt)` (N s/m / s), `m_s / dt^2`,
+    /// `J_s / dt^2`, half the seat distance (m).
+    dt: f64,
+    kb: f64,
+    cbh: f64,
+    ms: f64,
+    js: f64,
+    ls: f64,
+}
+
+impl Unilateral {
+    pub(super) fn new(p: &TrackParams, ns: usize, dt: f64) -> Self {
+        let mut u = Unilateral {
+            gap: vec![0.0; ns],
+            pad_limit: f64::INFINITY,
+            ballast_limit: vec![f64::INFINITY; ns],
+            pad_lifted: vec![CARRIES; 2 * ns],
+            ballast_lifted: vec![CARRIES; 2 * ns],
+            longest: 0.0,
+            longest_at: 0,
+            dt,
+            kb: 0.0,
+            cbh: 0.0,
+            ms: 0.0,
+            js: 0.0,
+            ls: 0.5 * p.rail_seat_distance,
+        };
+        u.set_dt(p, dt);
+        u.set_limits(p);
+        u
+    }
+
+    /// The coefficients of step `dt` (s).
+    pub(super) fn set_dt(&mut self, p: &TrackParams, dt: f64) {
+        self.dt = dt;
+        self.kb = p.ballast_stiffness;
+        self.cbh = p.ballast_damping / (2.0 * dt);
+        self.ms = p.sleeper_mass / (dt * dt);
+        self.js = p.sleeper_inertia / (dt * dt);
+    }
+
+    /// The limits from the law and the gaps.
+    pub(super) fn set_limits(&mut self, p: &TrackParams) {
+        let tensionless = p.supports.law == SupportLaw::Tensionless;
+        self.pad_limit = if tensionless {
+            p.supports.pad_preload
+        } else {
+            f64::INFINITY
+        };
+        for (lim, &g) in self.ballast_limit.iter_mut().zip(&self.gap) {
+            *lim = if g > 0.0 {
+                0.0
+            } else if tensionless {
+                p.supports.ballast_preload
+            } else {
+                f64::INFINITY
+            };
+        }
+    }
+
+    /// Takes one step of lift (or contact) of a support into its time and the longest.
+    #[inline]
+    fn lift(time: &mut f64, lifted: bool, dt: f64, longest: &mut (f64, i64), sleeper: usize) {
+        if lifted {
+            *time = time.max(0.0) + dt;
+            if *time > longest.0 {
+                *longest = (*time, sleeper as i64);
+            }
+        } else {
+            *time = CARRIES;
+        }
+    }
+
+    /// The ballast forces under the two seats (N, compression positive) of a sleeper
+    /// at `(z, f)` now, `(zp, fp)` a step back and `(zn, pn)` a step on, with its gap
+    /// `g` (m): `-K_b (u + g) - C_b du/dt`, the velocity a central difference as in
+    /// (3.18).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn ballast_forces(
+        &self,
+        z: f64,
+        f: f64,
+        zp: f64,
+        fp: f64,
+        zn: f64,
+        pn: f64,
+        g: f64,
+    ) -> [f64; 2] {
+        [-self.ls, self.ls].map(|arm| {
+            let (u, un, up) = (z + arm * f, zn + arm * pn, zp + arm * fp);
+            -self.kb * (u + g) - self.cbh * (un - up)
+        })
+    }
+
+    /// The sleeper's bounce and roll a step on (3.18) with the seats `on` carrying by
+    /// spring and damper and the others their limit `lim` (N) of tension: the implicit
+    /// damping of the carrying seats couples bounce and roll, a 2 x 2 solve. `fl`, `fr`:
+    /// the pad forces on the rails (N, up).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn solve(
+        &self,
+        z: f64,
+        f: f64,
+        zp: f64,
+        fp: f64,
+        fl: f64,
+        fr: f64,
+        g: f64,
+        lim: f64,
+        on: [bool; 2],
+    ) -> (f64, f64) {
+        let (ms, js, c) = (self.ms, self.js, self.cbh);
+        let (mut a11, mut a12, mut a22) = (ms, 0.0, js);
+        let mut b1 = ms * (2.0 * z - zp) - (fl + fr);
+        let mut b2 = js * (2.0 * f - fp) + self.ls * (fl - fr);
+        for (s, arm) in [(0, -self.ls), (1, self.ls)] {
+            if on[s] {
+                let (u, up) = (z + arm * f, zp + arm * fp);
+                a11 += c;
+                a12 += c * arm;
+                a22 += c * arm * arm;
+                let r = -self.kb * (u + g) + c * up;
+                b1 += r;
+                b2 += arm * r;
+            } else {
+                b1 -= lim;
+                b2 -= arm * lim;
+            }
+        }
+        let det = a11 * a22 - a12 * a12;
+        ((b1 * a22 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det)
+    }
+
+    /// Supports lifted now: pads, ballast seats.
+    pub(super) fn lifted_now(&self) -> (usize, usize) {
+        let count = |v: &[f64]| v.iter().filter(|&&t| t >= 0.0).count();
+        (count(&self.pad_lifted), count(&self.ballast_lifted))
+    }
+}
+
+/// [`sleepers_body`] with supports that can lift: the pad forces (3.9) clamped at the
+/// pad's limit, then each sleeper's update (3.18) with the seats whose ballast carries
+/// (the same expressions, bit for bit, for a sleeper whose seats both carry and that
+/// has no gap), the others at their limit; the seats that carry are found by at most
+/// three passes (two seats: the passes settle at once but for a seat at its limit to
+/// rounding). Also counts each support's lift.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn sleepers_unilateral<const FMA: bool>(
+    rl: &[f64],
+    rr: &[f64],
+    rlp: &[f64],
+    rrp: &[f64],
+    zs: &[f64],
+    ph: &[f64],
+    zsp: &mut [f64],
+    php: &mut [f64],
+    pl: &mut [f64],
+    pr: &mut [f64],
+    c: &SleeperCoeffs,
+    u: &mut Unilateral,
+) {
+    let ns = u.gap.len();
+    let dt = u.dt;
+    let mut longest = (u.longest, u.longest_at);
+    for i in 0..ns {
+        let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
+        let (ul, ur) = (
+            rl[i] - madd::<FMA>(-c.ls, f, z),
+            rr[i] - madd::<FMA>(c.ls, f, z),
+        );
+        let (upl, upr) = (
+            rlp[i] - madd::<FMA>(-c.ls, fp, zp),
+            rrp[i] - madd::<FMA>(c.ls, fp, zp),
+        );
+        let mut fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
+        let mut fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
+        let lim = u.pad_limit;
+        let (lifted_l, lifted_r) = (fl < -lim, fr < -lim);
+        if lifted_l {
+            fl = -lim;
+        }
+        if lifted_r {
+            fr = -lim;
+        }
+        Unilateral::lift(&mut u.pad_lifted[i], lifted_l, dt, &mut longest, i);
+        Unilateral::lift(&mut u.pad_lifted[ns + i], lifted_r, dt, &mut longest, i);
+        pl[i] = fl;
+        pr[i] = fr;
+        let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+        let mut on = [true, true];
+        let (mut zn, mut pn) = if g == 0.0 {
+            (
+                madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z)),
+                madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f)),
+            )
+        } else {
+            u.solve(z, f, zp, fp, fl, fr, g, lim, on)
+        };
+        if lim.is_finite() {
+            for _ in 0..3 {
+                let force = u.ballast_forces(z, f, zp, fp, zn, pn, g);
+                let carries = force.map(|x| x >= -lim);
+                if carries == on {
+                    break;
+                }
+                on = carries;
+                (zn, pn) = u.solve(z, f, zp, fp, fl, fr, g, lim, on);
+            }
+        }
+        zsp[i] = zn;
+        php[i] = pn;
+        Unilateral::lift(&mut u.ballast_lifted[i], !on[0], dt, &mut longest, i);
+        Unilateral::lift(&mut u.ballast_lifted[ns + i], !on[1], dt, &mut longest, i);
+    }
+    (u.longest, u.longest_at) = longest;
+}
+
+impl Track {
+    /// Gaps between the sleepers and the ballast at rest (m, >= 0), one per sleeper
+    /// (`gaps.len()` = [`TrackParams::spans`] + 1): a sleeper with a gap hangs from the
+    /// rails (a voided sleeper) until it has moved down by its gap, and its ballast
+    /// never pulls. From this call on the track steps through the loop of supports
+    /// that can lift, which gives the linear loop's numbers bit for bit where no
+    /// support can lift (all zeros with linear supports: the thesis' track).
+    ///
+    /// Errors: a gap below 0, above 0.05 m or not finite (named `track.void.gap`), or
+    /// the wrong count.
+    pub fn set_sleeper_gaps(&mut self, gaps: &[f64]) -> Result<()> {
+        if gaps.len() != self.ns {
+            return Err(out_of_range(
+                "sleeper gaps",
+                gaps.len() as f64,
+                format!("one per sleeper: {}", self.ns),
+            ));
+        }
+        for &g in gaps {
+            if !(0.0..=0.05).contains(&g) {
+                return Err(out_of_range("track.void.gap", g, "0 m <= gap <= 0.05 m"));
+            }
+        }
+        let (p, ns, dt) = (self.params, self.ns, self.dt);
+        let u = self
+            .unilateral
+            .get_or_insert_with(|| Box::new(Unilateral::new(&p, ns, dt)));
+        u.gap.copy_from_slice(gaps);
+        u.set_limits(&p);
+        Ok(())
+    }
+
+    /// Whether a support can lift (tensionless supports or a gap under a sleeper).
+    pub fn supports_can_lift(&self) -> bool {
+        self.unilateral.is_some()
+    }
+
+    /// Supports lifted now: rail pads (of both rails), ballast seats (two per sleeper).
+    pub fn lifted_supports(&self) -> (usize, usize) {
+        self.unilateral.as_ref().map_or((0, 0), |u| u.lifted_now())
+    }
+
+    /// The longest lift of any support (pad or ballast seat) since the start (s) and
+    /// its sleeper's index in the track as it is now (below 0 when an endless track's
+    /// window has left it behind); `(0, 0)` when none has lifted.
+    pub fn longest_lift(&self) -> (f64, i64) {
+        self.unilateral
+            .as_ref()
+            .map_or((0.0, 0), |u| (u.longest, u.longest_at))
+    }
+
+    /// Whether the pad of `rail` (0 left, 1 right) on sleeper `i` and the ballast under
+    /// that seat are lifted now.
+    pub fn lifted(&self, rail: usize, i: usize) -> (bool, bool) {
+        self.unilateral.as_ref().map_or((false, false), |u| {
+            let at = rail.min(1) * self.ns + i;
+            (u.pad_lifted[at] >= 0.0, u.ballast_lifted[at] >= 0.0)
+        })
+    }
+
+    /// How long the pad of `rail` (0 left, 1 right) on sleeper `i` and the ballast
+    /// under that seat have been lifted without a break (s); 0 while they carry.
+    pub fn lift_times(&self, rail: usize, i: usize) -> (f64, f64) {
+        self.unilateral.as_ref().map_or((0.0, 0.0), |u| {
+            let at = rail.min(1) * self.ns + i;
+            (u.pad_lifted[at].max(0.0), u.ballast_lifted[at].max(0.0))
+        })
+    }
+
+    /// The static state of a track whose supports can lift: the active-set iteration
+    /// over the direct solve (each pass solves with the supports that carried in the
+    /// last, the others at their limit; the pads are settled before the ballast; a
+    /// pass that changes none ends it). At most 50 passes.
+    pub(super) fn set_static_unilateral(&mut self, f: &[f64]) -> Result<()> {
+        let (nk, ns) = (self.nk, self.ns);
+        let u = self.unilateral.as_ref().expect("supports that can lift");
+        let (pad_lim, kp, kb) = (
+            u.pad_limit,
+            self.params.pad_stiffness,
+            self.params.ballast_stiffness,
+        );
+        let ls = 0.5 * self.params.rail_seat_distance;
+        let (izs, iph) = (4 * nk, 4 * nk + ns);
+        let n = self.params.nodes_per_span;
+        let mut pad_on = vec![true; 2 * ns];
+        let mut ballast_on = vec![true; 2 * ns];
+        // A support lets go beyond its limit by more than this (N): one that sits at
+        // it (a hanging sleeper's pads with no preload) keeps carrying.
+        let tol = 1e-6;
+        for _ in 0..50 {
+            let mut rhs = f.to_vec();
+            for i in 0..ns {
+                let node = i * n;
+                let fixed = node == 0 || node == nk - 1;
+                let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+                for (s, arm) in [(0usize, -ls), (1usize, ls)] {
+                    if !pad_on[s * ns + i] {
+                        if !fixed {
+                            rhs[s * nk + node] -= pad_lim;
+                        }
+                        rhs[izs + i] += pad_lim;
+                        rhs[iph + i] += arm * pad_lim;
+                    }
+                    let load = if ballast_on[s * ns + i] {
+                        -kb * g
+                    } else {
+                        -lim
+                    };
+                    rhs[izs + i] += load;
+                    rhs[iph + i] += arm * load;
+                }
+            }
+            let order = self.static_order_along_track();
+            let on = (pad_on.as_slice(), ballast_on.as_slice());
+            let x = solve_banded_spd(
+                &order,
+                |add| self.stiffness_entries_with(Some(on), add),
+                &rhs,
+            )
+            .ok_or_else(|| {
+                Error::Unsupported(
+                    "the static state of a track whose lifted supports leave a sleeper \
+                         free (no pad or ballast holds it): give the pads a preload \
+                         (track.pad.preload) or the hanging sleepers a smaller gap"
+                        .into(),
+                )
+            })?;
+            // The pads first: a pass that releases or takes back a pad leaves the
+            // ballast as it was (released together, a sleeper's pads and ballast
+            // would leave it free, where its ballast carries nothing once the pads
+            // have let go).
+            let mut pads = pad_on.clone();
+            let mut seats = ballast_on.clone();
+            for i in 0..ns {
+                let node = i * n;
+                let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+                for (s, arm) in [(0usize, -ls), (1usize, ls)] {
+                    let seat = x[izs + i] + arm * x[iph + i];
+                    let pad = -kp * (x[s * nk + node] - seat);
+                    let slack = if pad_on[s * ns + i] { tol } else { 0.0 };
+                    pads[s * ns + i] = pad >= -pad_lim - slack;
+                    let ballast = -kb * (seat + g);
+                    let slack = if ballast_on[s * ns + i] { tol } else { 0.0 };
+                    seats[s * ns + i] = ballast >= -lim - slack;
+                }
+            }
+            let changed = if pads != pad_on {
+                pad_on = pads;
+                true
+            } else if seats != ballast_on {
+                ballast_on = seats;
+                true
+            } else {
+                false
+            };
+            if !changed {
+                self.set_static_state(&x);
+                for i in 0..2 * ns {
+                    if !pad_on[i] {
+                        let at = (i / ns) * self.sp + i % ns;
+                        self.pad[at] = -pad_lim;
+                    }
+                }
+                // The supports lifted at the start, for no time yet.
+                let u = self.unilateral.as_mut().expect("supports that can lift");
+                let at_start = |on: &[bool], t: &mut [f64]| {
+                    for (t, &on) in t.iter_mut().zip(on) {
+                        *t = if on { CARRIES } else { 0.0 };
+                    }
+                };
+                at_start(&pad_on, &mut u.pad_lifted);
+                at_start(&ballast_on, &mut u.ballast_lifted);
+                (u.longest, u.longest_at) = (0.0, 0);
+                return Ok(());
+            }
+        }
+        Err(Error::Unsupported(
+            "the static state of the track's lifting supports: the active-set \
+             iteration did not settle in 50 passes"
+                .into(),
+        ))
+    }
+}

@@ -1,0 +1,125 @@
+//! Supports that lift in the coupled engine: the reference flat's impact on a track
+//! whose pads and ballast carry no tension, and a wheelset passing hanging sleepers on
+//! the endless track.
+
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, VoidedSleepers};
+use wheelflat::track::{SupportLaw, Supports};
+
+/// The reference flat case with observation points on the eight sleepers from 10.96 m
+/// to 15.76 m (the flat strikes at 5.1, 8.1, 11.1 and 14.1 m in 0.7 s).
+fn flat_case(supports: Supports) -> Simulation {
+    let mut s = Scenario::table_4_4_flat();
+    s.set_supports(supports);
+    s.sites = (16..24).map(|i| i as f64 * 0.685).collect();
+    Simulation::new(&s).unwrap()
+}
+
+/// The smallest rail seat and ballast forces (N, compression positive) over the sites,
+/// and the largest contact force on the flat wheel (N).
+fn extremes(sim: &Simulation) -> (f64, f64, f64) {
+    let min = |q: usize| {
+        sim.sites()
+            .iter()
+            .flat_map(|s| [s.min()[0][q], s.min()[1][q]])
+            .fold(f64::INFINITY, f64::min)
+    };
+    (min(3), min(5), sim.max_force()[0])
+}
+
+#[test]
+fn behind_the_flats_impact_tensionless_supports_let_go_instead_of_pulling() {
+    let mut linear = flat_case(Supports::default());
+    linear.run(0.7, |_| {}).unwrap();
+    let (seat, ballast, peak) = extremes(&linear);
+    // The thesis' linear seats pull the rail down hard behind the impact.
+    assert!(seat < -30e3, "{seat}");
+    assert!(ballast < -5e3, "{ballast}");
+
+    let preloads = Supports {
+        law: SupportLaw::Tensionless,
+        pad_preload: 20e3,
+        ballast_preload: 1.7e3,
+    };
+    let mut lifting = flat_case(preloads);
+    lifting.run(0.7, |_| {}).unwrap();
+    let (seat_t, ballast_t, peak_t) = extremes(&lifting);
+    // No seat pulls harder than the clip's 20 kN, no ballast seat than its 1.7 kN.
+    assert!(
+        seat_t >= -20e3 && ballast_t >= -1.7e3,
+        "{seat_t} {ballast_t}"
+    );
+    assert_eq!(ballast_t, -1.7e3, "a ballast seat lets go");
+    let t = match lifting.track() {
+        wheelflat::sim::TrackState::Discrete(t) => t,
+        _ => unreachable!(),
+    };
+    let (longest, _) = t.longest_lift();
+    assert!(longest > 1e-4, "{longest}");
+    let at = lifting.longest_lift_position();
+    assert!((0.0..30.0 * 0.685).contains(&at), "{at}");
+    // The impact's peak hardly moves: the wheel strikes a rail that is pressed down
+    // onto its supports, and what lets go lies behind and ahead of it.
+    assert!(
+        (peak_t / peak - 1.0).abs() < 0.02,
+        "{peak_t} against {peak}"
+    );
+    let lifted = lifting
+        .sites()
+        .iter()
+        .map(|s| s.max()[0][7].max(s.max()[1][7]))
+        .fold(0.0, f64::max);
+    assert!(lifted > 0.0, "a site saw its seat lifted off the ballast");
+}
+
+#[test]
+fn a_wheelset_closes_the_gap_under_hanging_sleepers_on_the_endless_track() {
+    // Three sleepers hang 0.3 mm above the ballast from 20.55 m (sleeper 30) on; the
+    // endless window reaches them, the wheelset rolls over them at 70 km/h, and the
+    // gap under the one it stands over closes: the sleeper sits on the ballast.
+    let run = |voids: Option<VoidedSleepers>| {
+        let mut s = Scenario::table_4_4();
+        s.window = Some(TrackWindow::DEFAULT);
+        s.speed = 70.0 / 3.6;
+        s.start_position = 10.0;
+        s.voids = voids;
+        s.sites = vec![31.0 * 0.685];
+        let mut sim = Simulation::new(&s).unwrap();
+        let (mut sag, mut swing) = (0.0f64, 0.0f64);
+        let w = sim.static_load()[0];
+        sim.run(0.9, |x| {
+            sag = sag.min(x.rail_z[0]);
+            swing = swing.max((x.contact[0].force - w).abs());
+        })
+        .unwrap();
+        (sim, sag, swing)
+    };
+    let (sim, sag, swing) = run(Some(VoidedSleepers {
+        position: 20.6,
+        sleepers: 3,
+        gap: 3e-4,
+    }));
+    let site = &sim.sites()[0];
+    // Hanging from the start (the static state) until the wheel came near, on the
+    // ballast while it was over it: the seat moved down beyond the gap.
+    assert!(site.max()[0][7] > 0.1, "hung for {} s", site.max()[0][7]);
+    assert!(site.min()[0][4] < -3e-4, "{}", site.min()[0][4]);
+    assert!(
+        site.max()[0][5] > 1e3,
+        "the ballast carried {}",
+        site.max()[0][5]
+    );
+    assert!(
+        site.min()[0][5] >= 0.0,
+        "and never pulled: {}",
+        site.min()[0][5]
+    );
+    let at = sim.longest_lift_position();
+    assert!((at - 31.0 * 0.685).abs() < 1.5 * 0.685, "{at}");
+    // The rail under the wheel sinks deeper over the hanging sleepers than anywhere
+    // on the intact track, by most of the gap (1.75 mm against 1.49 mm); the
+    // wheel's force swings a little further from the static load (1.82 kN against
+    // 1.68 kN at 70 km/h).
+    let (_, intact_sag, intact_swing) = run(None);
+    assert!(sag < intact_sag - 2e-4, "{sag} against {intact_sag}");
+    assert!(swing > intact_swing, "{swing} against {intact_swing}");
+}
