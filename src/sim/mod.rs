@@ -3,6 +3,7 @@
 //! units, which share one clock, one way of counting steps and one record of force
 //! extremes.
 
+mod accelerations;
 mod clock;
 mod health;
 mod inputs;
@@ -16,6 +17,7 @@ mod tests;
 mod vehicle_unit;
 mod wheelset;
 
+pub use accelerations::Accelerations;
 pub use clock::StepPlan;
 pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,

@@ -589,6 +589,25 @@ impl Simulation {
             shared_side_frames,
             voids: s.voids,
         };
+        if let (Some(v), None, TrackState::Discrete(t)) = (&sim.voids, &sim.window, &sim.track) {
+            // On a fixed track every hanging sleeper must be one of its sleepers.
+            let (a, spans) = (t.params().sleeper_spacing, t.params().spans);
+            let first = (v.position / a).round();
+            if !(first >= 0.0 && first + v.sleepers as f64 - 1.0 <= spans as f64) {
+                return Err(out_of_range(
+                    "track.void.position",
+                    v.position,
+                    format!(
+                        "a run of track.void.sleepers = {} sleepers within the fixed track's {} \
+                         sleepers: -{} m <= track.void.position < {} m",
+                        v.sleepers,
+                        spans + 1,
+                        num(0.5 * a),
+                        num((spans as f64 + 1.5 - v.sleepers as f64) * a)
+                    ),
+                ));
+            }
+        }
         sim.place_voids()?;
         sim.set_static()?;
         sim.check_static_sag()?;
@@ -1046,9 +1065,11 @@ impl Simulation {
                 return Err(self.force_diverged(p, time));
             }
         }
+        let dt = self.clock.dt;
         for w in self.wheelsets.trailing_mut() {
             let p = w.forces();
             w.extremes.record(p);
+            w.record_accelerations(dt);
             w.vehicle.step(p);
         }
         Ok(())
@@ -1137,8 +1158,10 @@ impl Simulation {
         if !self.wheelsets.trailing().is_empty() {
             self.advance_trailing(time)?;
         }
+        let dt = self.clock.dt;
         let lead = self.wheelsets.lead_mut();
         lead.extremes.record(p);
+        lead.record_accelerations(dt);
         lead.vehicle.step(p);
         if self.shared_side_frames {
             self.share_side_frames();

@@ -11,10 +11,14 @@ use crate::track::Track;
 
 /// The quantities recorded at a site for each rail, in the order of [`SiteValues`]:
 /// rail displacement (m), rail bending moment (N m), rail shear force (N), rail seat
-/// force (N), seat displacement (m), ballast force (N), and how long the rail has been
+/// force (N), seat displacement (m), ballast force (N), how long the rail has been
 /// lifted off the pad and the seat off the ballast without a break (s) (see
-/// [`crate::track::RailResponse`] and [`crate::track::SupportResponse`]).
-pub const SITE_QUANTITIES: [&str; 8] = [
+/// [`crate::track::RailResponse`] and [`crate::track::SupportResponse`]), and the
+/// rail's and the seat's vertical acceleration (m/s^2, up): the central second
+/// difference of their displacements at the track's steps, at one step before the
+/// current time (summed twice it gives the displacements back exactly; the run starts
+/// at rest).
+pub const SITE_QUANTITIES: [&str; 10] = [
     "rail.z",
     "rail.bending_moment",
     "rail.shear_force",
@@ -23,7 +27,12 @@ pub const SITE_QUANTITIES: [&str; 8] = [
     "ballast.force",
     "seat.lifted",
     "ballast.lifted",
+    "rail.acceleration",
+    "seat.acceleration",
 ];
+
+/// The displacements whose accelerations a site keeps: rail (0) and seat (4).
+const MOVING: [usize; 2] = [0, 4];
 
 /// Number of [`SITE_QUANTITIES`].
 const NQ: usize = SITE_QUANTITIES.len();
@@ -35,6 +44,9 @@ pub type SiteValues = [[f64; NQ]; 2];
 #[derive(Debug, Clone, PartialEq)]
 pub struct Site {
     position: f64,
+    /// The rail's and the seat's displacements ([`MOVING`]) of each rail at the last
+    /// two steps, the latest first (m).
+    before: [[[f64; 2]; 2]; 2],
     now: SiteValues,
     max: SiteValues,
     min: SiteValues,
@@ -78,13 +90,32 @@ impl Site {
                 s.ballast_force,
                 s.pad_lifted,
                 s.ballast_lifted,
+                0.0,
+                0.0,
             ]
         })
     }
 
+    /// The accelerations of [`MOVING`] in `now` from the history, step `dt` (s).
+    fn accelerate(&mut self, dt: f64) {
+        let k = 1.0 / (dt * dt);
+        for rail in 0..2 {
+            for (m, &q) in MOVING.iter().enumerate() {
+                let [a, b] = self.before[rail][m];
+                self.now[rail][NQ - 2 + m] = (self.now[rail][q] - 2.0 * a + b) * k;
+            }
+        }
+    }
+
     /// Reads the track now and takes the values into the extremes.
     pub(crate) fn record(&mut self, track: &Track, origin: f64) {
+        for rail in 0..2 {
+            for (m, &q) in MOVING.iter().enumerate() {
+                self.before[rail][m] = [self.now[rail][q], self.before[rail][m][0]];
+            }
+        }
         self.now = Self::read(track, origin, self.position);
+        self.accelerate(track.dt());
         for rail in 0..2 {
             for q in 0..NQ {
                 let x = self.now[rail][q];
@@ -94,21 +125,36 @@ impl Site {
         }
     }
 
-    /// Values of the extremes in the order state vectors store them.
+    /// Values of the extremes and of the accelerations' history in the order state
+    /// vectors store them.
     pub(crate) fn extremes(&self) -> impl Iterator<Item = f64> + '_ {
-        self.max.iter().chain(&self.min).flatten().copied()
+        let before = self.before.iter().flatten().flatten();
+        self.max
+            .iter()
+            .chain(&self.min)
+            .flatten()
+            .chain(before)
+            .copied()
     }
 
     /// Number of values [`Site::extremes`] yields.
-    pub(crate) const STATE_LEN: usize = 4 * NQ;
+    pub(crate) const STATE_LEN: usize = 4 * NQ + 8;
 
-    /// Restores the extremes from [`Site::extremes`] and reads the track now.
+    /// Restores the extremes and history from [`Site::extremes`] and reads the track
+    /// now.
     pub(crate) fn restore(&mut self, track: &Track, origin: f64, v: &[f64]) {
-        let slots = self.max.iter_mut().chain(&mut self.min).flatten();
+        let before = self.before.iter_mut().flatten().flatten();
+        let slots = self
+            .max
+            .iter_mut()
+            .chain(&mut self.min)
+            .flatten()
+            .chain(before);
         for (slot, &x) in slots.zip(v) {
             *slot = x;
         }
         self.now = Self::read(track, origin, self.position);
+        self.accelerate(track.dt());
     }
 }
 
@@ -149,8 +195,11 @@ pub(crate) fn sites(
                 ));
             }
             let now = Site::read(track, origin, x);
+            // At rest before the start: the history holds the static state.
+            let at_rest = |rail: usize| MOVING.map(|q| [now[rail][q]; 2]);
             Ok(Site {
                 position: x,
+                before: [at_rest(0), at_rest(1)],
                 now,
                 max: now,
                 min: now,

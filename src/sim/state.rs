@@ -1,6 +1,7 @@
 //! The state vector of a simulation: everything that determines the continuation, so
 //! that a saved run continues bit for bit (FMU states).
 
+use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;
 use super::simulation::{InputRates, Motion, Simulation, TrackState, VehicleState};
 use super::sites::Site;
@@ -14,7 +15,9 @@ const CLOCK: usize = 4;
 impl Simulation {
     /// Everything that determines the continuation: the clock (step (s), `t0` (s),
     /// steps since `t0`, steps since the start), the force extremes of every wheelset
-    /// (`[max left, max right, min left, min right]` (N)), the sites' extremes, the
+    /// (`[max left, max right, min left, min right]` (N)) with its contact forces of
+    /// the step before and its accelerations' history and extremes
+    /// ([`super::Accelerations`]), the sites' extremes, the
     /// track's state, then each wheelset's vehicle's (the roll-plane vehicle's step
     /// and displacements, or the external wheels' inputs: `z` `[left, right]` (m), the
     /// axle angle (rad) and the time (s) it was given at), the motion (position (m)
@@ -34,6 +37,7 @@ impl Simulation {
         for w in self.wheelsets.iter() {
             v.extend(w.extremes.to_array());
             v.extend(w.latest().contact.map(|c| c.force));
+            v.extend(w.accelerations.to_array());
         }
         for site in &self.sites {
             v.extend(site.extremes());
@@ -111,7 +115,7 @@ impl Simulation {
         };
         let nv = Self::vehicle_state(&self.wheelsets.lead().vehicle)?.len();
         let nw = self.wheelsets.len();
-        let per_wheelset = ForceExtremes::LEN + 2;
+        let per_wheelset = ForceExtremes::LEN + 2 + Accelerations::LEN;
         let extremes_end = CLOCK + per_wheelset * self.wheelsets.len();
         let head = extremes_end + Site::STATE_LEN * self.sites.len();
         let nb = self.bogie.as_ref().map_or(0, |b| b.state_vector().len());
@@ -125,7 +129,7 @@ impl Simulation {
         }
         let forces = v[CLOCK..extremes_end].chunks_exact(per_wheelset);
         if let Some(&x) = forces
-            .flat_map(|x| &x[ForceExtremes::LEN..])
+            .flat_map(|x| &x[ForceExtremes::LEN..ForceExtremes::LEN + 2])
             .find(|x| !x.is_finite())
         {
             return Err(out_of_range(
@@ -191,6 +195,11 @@ impl Simulation {
             for (c, &f) in w.latest.contact.iter_mut().zip(&x[ForceExtremes::LEN..]) {
                 c.force = f;
             }
+            let a = &x[ForceExtremes::LEN + 2..];
+            if let Some(&bad) = a.iter().find(|x| !x.is_finite()) {
+                return Err(out_of_range("state: accelerations", bad, "finite"));
+            }
+            w.accelerations = Accelerations::from_slice(a);
         }
         if let TrackState::Discrete(t) = &self.track {
             let stored = v[extremes_end..head].chunks_exact(Site::STATE_LEN);

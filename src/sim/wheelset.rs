@@ -1,6 +1,7 @@
 //! The wheelsets of a simulation: each with its two wheels, its place behind the
 //! leading wheelset and its contact states, and the loads they put on the rails.
 
+use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;
 use super::simulation::VehicleState;
 use crate::contact::{ContactLaw, ContactState};
@@ -37,6 +38,8 @@ pub struct Wheelset {
     offset: f64,
     pub(crate) vehicle: VehicleState,
     pub(crate) extremes: ForceExtremes,
+    /// The wheels' and the rail's accelerations under them.
+    pub(crate) accelerations: Accelerations,
     // The sample of the latest step, contact states included, built here in place by
     // `Simulation::step` (a sample built in a temporary and copied at once stalled the
     // copy's wide loads on the narrow stores that had just built it).
@@ -69,6 +72,7 @@ impl Wheelset {
             offset,
             vehicle,
             extremes: ForceExtremes::NONE,
+            accelerations: Accelerations::NONE,
             latest: Sample::default(),
             cached: Cell::new(None),
         })
@@ -105,6 +109,25 @@ impl Wheelset {
     pub fn min_force(&self) -> [f64; 2] {
         self.extremes.min
     }
+    /// The vertical accelerations `[wheel left, wheel right, rail left, rail right]`
+    /// (m/s^2, up) when the sample now is `now` and the step `dt` (s), with their
+    /// largest and smallest since the start: the second differences of
+    /// [`Sample::wheel_z`] and [`Sample::rail_z`] at the engine's steps
+    /// ([`Accelerations`]).
+    pub fn accelerations(&self, now: &Sample, dt: f64) -> [[f64; 4]; 3] {
+        let z = [now.wheel_z[0], now.wheel_z[1], now.rail_z[0], now.rail_z[1]];
+        let a = self.accelerations.now(z, dt);
+        [a, self.accelerations.max(a), self.accelerations.min(a)]
+    }
+
+    /// Takes the latest sample's displacements into the accelerations, step `dt` (s).
+    #[inline(always)]
+    pub(crate) fn record_accelerations(&mut self, dt: f64) {
+        let s = &self.latest;
+        let z = [s.wheel_z[0], s.wheel_z[1], s.rail_z[0], s.rail_z[1]];
+        self.accelerations.record(z, dt);
+    }
+
     /// The wheels, the vehicle and the latest sample, to build the sample in place.
     #[inline(always)]
     pub(crate) fn parts_mut(&mut self) -> (&[WheelProfile; 2], &VehicleState, &mut Sample) {

@@ -88,6 +88,15 @@ impl FmuModel {
             View::Sim(_, s) => f(&s.contact[side]),
             View::Vehicle(_) => f64::NAN,
         };
+        // Wheelset `index`'s accelerations `[now, max, min]` of `[wheel left, wheel
+        // right, rail left, rail right]`.
+        let accel = |which: usize, signal: usize| match view {
+            View::Sim(sim, s) => sim
+                .wheelsets()
+                .get(index)
+                .map_or(0.0, |w| w.accelerations(s, sim.dt())[which][signal]),
+            View::Vehicle(_) => f64::NAN,
+        };
         // The discrete track of a track-carrying model.
         let lifted = |f: fn(&crate::track::Track) -> f64| match view {
             View::Sim(sim, _) => match sim.track() {
@@ -243,7 +252,19 @@ impl FmuModel {
             | Quantity::SiteSeatLifted
             | Quantity::SiteSeatLiftedMax
             | Quantity::SiteBallastLifted
-            | Quantity::SiteBallastLiftedMax => f64::NAN,
+            | Quantity::SiteBallastLiftedMax
+            | Quantity::SiteRailAcceleration
+            | Quantity::SiteRailAccelerationMax
+            | Quantity::SiteRailAccelerationMin
+            | Quantity::SiteSeatAcceleration
+            | Quantity::SiteSeatAccelerationMax
+            | Quantity::SiteSeatAccelerationMin => f64::NAN,
+            Quantity::WheelAcceleration => accel(0, side),
+            Quantity::WheelAccelerationMax => accel(1, side),
+            Quantity::WheelAccelerationMin => accel(2, side),
+            Quantity::RailAcceleration => accel(0, 2 + side),
+            Quantity::RailAccelerationMax => accel(1, 2 + side),
+            Quantity::RailAccelerationMin => accel(2, 2 + side),
             // Supports that lift, over the whole track.
             Quantity::TrackLiftedPads => lifted(|t| t.lifted_supports().0 as f64),
             Quantity::TrackLiftedBallast => lifted(|t| t.lifted_supports().1 as f64),
@@ -285,6 +306,12 @@ fn site_value(engine: &Engine, q: Quantity, side: usize, index: usize) -> Option
         SiteSeatLiftedMax => (6, 1),
         SiteBallastLifted => (7, 0),
         SiteBallastLiftedMax => (7, 1),
+        SiteRailAcceleration => (8, 0),
+        SiteRailAccelerationMax => (8, 1),
+        SiteRailAccelerationMin => (8, 2),
+        SiteSeatAcceleration => (9, 0),
+        SiteSeatAccelerationMax => (9, 1),
+        SiteSeatAccelerationMin => (9, 2),
         _ => return None,
     };
     let Engine::Sim(sim) = engine else {
