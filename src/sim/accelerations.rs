@@ -9,7 +9,7 @@ pub const SIGNALS: usize = 4;
 
 /// The accelerations of a wheelset's signals (wheels, rail under them) with their
 /// extremes since the start. The engine records the sample that drives each step
-/// ([`Accelerations::record`]); the acceleration at the current time `t` is
+/// (its crate-private `record`); the acceleration at the current time `t` is
 /// `(z(t) - 2 z(t - dt) + z(t - 2 dt)) / dt^2`, the central second difference at
 /// `t - dt`, one step (about 10 us) behind: summed twice it gives the displacements
 /// back exactly. The run starts in the static state: the wheels at rest, as if they
