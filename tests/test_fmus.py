@@ -1446,8 +1446,10 @@ def test_every_declared_directional_derivative_is_answered_and_the_rest_is_zero(
     # The declared pairs of wheelset 1 at each of the two points: per wheel force, front
     # and rear angle, length, max and min, the overlap and the rail under the wheel
     # against its height and the rotation (16: the overlap and the rail follow the
-    # rotation through the force and the rail's shear kink under it).
-    assert answered == 2 * 2 * 16, answered
+    # rotation through the force and the rail's shear kink under it); and (issue 27)
+    # the wheel's acceleration against its height, the rail's under it against the
+    # height and the rotation: 19.
+    assert answered == 2 * 2 * 19, answered
     t.close()
     # At the axle boxes the primary forces follow their side frame at once: -K_1, -C_1.
     t = initialised(paths, "TrackContact", params={"interface": 2})

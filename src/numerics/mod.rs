@@ -11,6 +11,7 @@ mod quadrature;
 mod roots;
 mod simd;
 mod small_angle;
+mod table;
 
 pub(crate) use banded::solve_banded_spd;
 pub(crate) use central_difference::{CentralDifference, check_critical_step};
@@ -19,3 +20,4 @@ pub(crate) use quadrature::gauss_legendre;
 pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};
 pub use small_angle::*;
+pub use table::{MAX_TABLE_POINTS, Table};

@@ -85,15 +85,26 @@ impl Accelerations {
         self.second_difference(&z, dt)
     }
 
-    /// The largest acceleration since the start (m/s^2), the current one `now`
-    /// included.
+    /// The largest acceleration of the steps taken (m/s^2; the one `now` before the
+    /// first step, the rest at the start after it): the value now is not among them,
+    /// so that they do not move with a master's inputs.
     pub fn max(&self, now: [f64; SIGNALS]) -> [f64; SIGNALS] {
-        std::array::from_fn(|i| self.max[i].max(now[i]))
+        if self.recorded == 0 { now } else { self.max }
     }
 
-    /// The smallest acceleration since the start (m/s^2), `now` included.
+    /// The smallest acceleration of the steps taken (m/s^2), as [`Accelerations::max`].
     pub fn min(&self, now: [f64; SIGNALS]) -> [f64; SIGNALS] {
-        std::array::from_fn(|i| self.min[i].min(now[i]))
+        if self.recorded == 0 { now } else { self.min }
+    }
+
+    /// `d a / d z` (1/s^2) of signal `i`'s acceleration now against its displacement
+    /// now: `1 / dt^2` once its history is there, else 0.
+    pub fn gain(&self, i: usize, dt: f64) -> f64 {
+        match self.recorded {
+            0 => 0.0,
+            1 if i >= 2 => 0.0,
+            _ => 1.0 / (dt * dt),
+        }
     }
 
     /// The values of a state vector.
@@ -157,6 +168,11 @@ mod tests {
         );
         assert!((now[2] - 6.0).abs() < 1e-6 && now[3] == 0.0);
         assert!(a.max(now)[0] > 100.0 && a.min(now)[1] < -100.0);
+        assert_eq!(
+            a.max([1e9; 4])[0],
+            a.max(now)[0],
+            "the value now is not an extreme"
+        );
         assert_eq!(Accelerations::from_slice(&a.to_array()), a);
         assert_eq!(
             Accelerations::from_slice(&Accelerations::NONE.to_array()),

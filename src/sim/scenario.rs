@@ -10,11 +10,13 @@
 //!   (it implies C_H ~ 1.0e10 N/m^1.5); the printed value is kept.
 
 use crate::contact::ContactModel;
+use crate::track::RailProfile;
 use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
 use crate::vehicle::{
     HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
 };
-use crate::wheel::FlatSpec;
+use crate::wheel::{FlatSpec, OutOfRoundness};
+use std::sync::Arc;
 
 /// Which track model carries the loads.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,6 +110,12 @@ pub struct Scenario {
     /// Hanging (voided) sleepers of the discrete track; `None`: every sleeper on the
     /// ballast.
     pub voids: Option<VoidedSleepers>,
+    /// The rails' vertical profiles `[left, right]` along the line (measured heights,
+    /// a dipped weld or joint); default: ideal rails.
+    pub rails: [RailProfile; 2],
+    /// The leading wheelset's measured out-of-roundness `[left, right]`; `None`: round
+    /// but for the flats.
+    pub roundness: [Option<Arc<OutOfRoundness>>; 2],
 }
 
 /// Sleepers in a row that hang from the rails with a gap above the ballast, which
@@ -168,6 +176,8 @@ pub struct TrailingWheelset {
     pub offset: f64,
     /// Flats on the left (0) and right (1) wheel.
     pub flats: [Vec<FlatSpec>; 2],
+    /// Measured out-of-roundness of the left (0) and right (1) wheel.
+    pub roundness: [Option<Arc<OutOfRoundness>>; 2],
 }
 
 /// The window of an endless track: the lengths of track kept ahead of the leading
@@ -263,6 +273,8 @@ impl Scenario {
             trailing: Vec::new(),
             window: None,
             voids: None,
+            rails: Default::default(),
+            roundness: Default::default(),
         }
     }
 
@@ -340,6 +352,8 @@ impl Scenario {
             trailing: Vec::new(),
             window: None,
             voids: None,
+            rails: Default::default(),
+            roundness: Default::default(),
         }
     }
 
@@ -436,6 +450,8 @@ impl Scenario {
             trailing: Vec::new(),
             window: None,
             voids: None,
+            rails: Default::default(),
+            roundness: Default::default(),
         }
     }
 

@@ -19,7 +19,7 @@ use crate::limits::{
 use crate::sim::{
     DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec, VoidedSleepers,
 };
-use crate::track::{PointLoad, SimdLevel, Track, TrackParams};
+use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
 use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
@@ -256,6 +256,10 @@ pub struct Simulation {
     /// The hanging sleepers ([`Scenario::voids`]), placed on the track anew whenever an
     /// endless track's window moves.
     pub(super) voids: Option<VoidedSleepers>,
+    /// Whether a rail has a profile or a wheel an out-of-roundness.
+    pub(super) irregular: bool,
+    /// The rails' vertical profiles `[left, right]` ([`Scenario::rails`]).
+    pub(super) rails: [RailProfile; 2],
 }
 
 /// Runs `f` compiled for `level`, AVX2 at most (see [`SimdLevel::run`]).
@@ -510,14 +514,18 @@ impl Simulation {
                 },
             })
         };
-        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?;
+        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?
+            .with_roundness(s.roundness.clone());
         let trailing = s
             .trailing
             .iter()
             .zip(2..)
             .map(|(w, k)| {
                 let name = format!("wheelset[{k}].");
-                Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?, &name)
+                Ok(
+                    Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?, &name)?
+                        .with_roundness(w.roundness.clone()),
+                )
             })
             .collect::<Result<Vec<_>>>()?;
         let wheelsets = Wheelsets::new(lead, trailing);
@@ -588,6 +596,12 @@ impl Simulation {
             bogie,
             shared_side_frames,
             voids: s.voids,
+            irregular: s.rails.iter().any(RailProfile::is_some)
+                || s.roundness
+                    .iter()
+                    .chain(s.trailing.iter().flat_map(|w| &w.roundness))
+                    .any(Option::is_some),
+            rails: s.rails.clone(),
         };
         if let (Some(v), None, TrackState::Discrete(t)) = (&sim.voids, &sim.window, &sim.track) {
             // On a fixed track every hanging sleeper must be one of its sleepers.
@@ -910,8 +924,32 @@ impl Simulation {
         };
         (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = self.sample_head(w);
         let compliance = self.compliance_under(s.position - self.origin);
-        contact_states(&w.vehicle, &self.law, w.wheels(), compliance, &mut s);
+        let shift = self.irregularity_of(w, s.position, s.rotation);
+        contact_states(&w.vehicle, &self.law, w.wheels(), compliance, shift, &mut s);
         s
+    }
+
+    /// What the rails' profiles and the wheels' out-of-roundness add to the overlaps
+    /// `[left, right]` (m) of wheelset `w` at line position `x` (m) and axle rotation
+    /// `gamma` (rad): the rail's height there plus the wheel's radius deviation at the
+    /// angle that touches the rail (`docs/MODEL.md`, "Measured irregularities");
+    /// `None` when there are none.
+    #[inline(always)]
+    pub(super) fn irregularity_of(&self, w: &Wheelset, x: f64, gamma: f64) -> Option<[f64; 2]> {
+        if !self.irregular {
+            return None;
+        }
+        Some([0, 1].map(|i| self.rails[i].at(x).0 + w.radius_deviation(i, gamma)))
+    }
+
+    /// The overlap's change `[left, right]` (m) of wheelset `k` (0 the leading one)
+    /// from the rails' profiles and its wheels' out-of-roundness now; zeros when there
+    /// are none.
+    pub fn irregularity(&self, k: usize) -> [f64; 2] {
+        self.wheelsets.get(k).map_or([0.0; 2], |w| {
+            self.irregularity_of(w, w.position(self.position()), self.rotation_of(w))
+                .unwrap_or([0.0; 2])
+        })
     }
 
     /// The rail's local compliance (m/N) under wheels at track position `x` (m):
@@ -1018,9 +1056,10 @@ impl Simulation {
         } else {
             let head = self.sample_head(self.lead());
             let compliance = self.compliance_under(head.1 - self.origin);
+            let shift = self.irregularity_of(self.lead(), head.1, head.2);
             let (wheels, vehicle, s) = self.wheelsets.lead_mut().parts_mut();
             (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
-            contact_states(vehicle, &self.law, wheels, compliance, s);
+            contact_states(vehicle, &self.law, wheels, compliance, shift, s);
         }
         if !displacements_within(&self.lead().latest) {
             return Err(self.displacement_diverged(self.lead()));

@@ -109,7 +109,9 @@ impl Simulation {
                 TrackState::Lumped(t) => t.rail_z(),
             };
             let delta = [0, 1].map(|i| self.law.overlap_for_force(&w.wheels()[i], 0.0, p[i]));
-            let zw = [zr[0] - delta[0], zr[1] - delta[1]];
+            // The rails' profiles and the wheels' out-of-roundness where they touch.
+            let h = self.irregularity(k);
+            let zw = [zr[0] - delta[0] + h[0], zr[1] - delta[1] + h[1]];
             // The static loads start the first step's contact solve (the force of
             // "the step before"), so a wheelset at rest stays there to rounding.
             let latest = &mut self.wheelsets.get_mut(k).expect("k < len").latest;

@@ -7,8 +7,10 @@ use super::simulation::VehicleState;
 use crate::contact::{ContactLaw, ContactState};
 use crate::error::{Result, non_negative};
 use crate::track::PointLoad;
+use crate::wheel::OutOfRoundness;
 use crate::wheel::{FlatSpec, WheelProfile};
 use std::cell::Cell;
+use std::sync::Arc;
 
 /// Everything reported at one instant for one wheelset.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -35,6 +37,8 @@ pub struct Sample {
 #[derive(Debug, Clone)]
 pub struct Wheelset {
     wheels: [WheelProfile; 2],
+    /// The wheels' measured out-of-roundness (none: round but for the flats).
+    roundness: [Option<Arc<OutOfRoundness>>; 2],
     offset: f64,
     pub(crate) vehicle: VehicleState,
     pub(crate) extremes: ForceExtremes,
@@ -69,6 +73,7 @@ impl Wheelset {
                 WheelProfile::new(radius, &flats[0], &format!("{name}flat.left"))?,
                 WheelProfile::new(radius, &flats[1], &format!("{name}flat.right"))?,
             ],
+            roundness: [None, None],
             offset,
             vehicle,
             extremes: ForceExtremes::NONE,
@@ -76,6 +81,27 @@ impl Wheelset {
             latest: Sample::default(),
             cached: Cell::new(None),
         })
+    }
+
+    /// The wheelset with the wheels' measured out-of-roundness `[left, right]`.
+    pub fn with_roundness(mut self, roundness: [Option<Arc<OutOfRoundness>>; 2]) -> Self {
+        self.roundness = roundness;
+        self
+    }
+
+    /// The radius deviation (m) of wheel `i` (0 left, 1 right) where it touches the
+    /// rail at axle rotation `gamma` (rad): its out-of-roundness at wheel angle
+    /// `gamma`; 0 for a wheel without one.
+    #[inline(always)]
+    pub fn radius_deviation(&self, i: usize, gamma: f64) -> f64 {
+        self.roundness[i].as_ref().map_or(0.0, |r| r.at(gamma))
+    }
+
+    /// `d/d gamma` of [`Wheelset::radius_deviation`] (m/rad).
+    pub fn radius_deviation_slope(&self, i: usize, gamma: f64) -> f64 {
+        self.roundness[i]
+            .as_ref()
+            .map_or(0.0, |r| r.slope_at(gamma))
     }
 
     /// The wheels `[left, right]`.
@@ -111,13 +137,18 @@ impl Wheelset {
     }
     /// The vertical accelerations `[wheel left, wheel right, rail left, rail right]`
     /// (m/s^2, up) when the sample now is `now` and the step `dt` (s), with their
-    /// largest and smallest since the start: the second differences of
+    /// largest and smallest of the steps taken: the second differences of
     /// [`Sample::wheel_z`] and [`Sample::rail_z`] at the engine's steps
     /// ([`Accelerations`]).
     pub fn accelerations(&self, now: &Sample, dt: f64) -> [[f64; 4]; 3] {
         let z = [now.wheel_z[0], now.wheel_z[1], now.rail_z[0], now.rail_z[1]];
         let a = self.accelerations.now(z, dt);
         [a, self.accelerations.max(a), self.accelerations.min(a)]
+    }
+
+    /// The accelerations' record, for their derivatives.
+    pub fn acceleration_record(&self) -> &Accelerations {
+        &self.accelerations
     }
 
     /// Takes the latest sample's displacements into the accelerations, step `dt` (s).
@@ -259,6 +290,7 @@ pub(crate) fn contact_states(
     law: &ContactLaw,
     wheels: &[WheelProfile; 2],
     compliance: f64,
+    irregularity: Option<[f64; 2]>,
     s: &mut Sample,
 ) {
     match vehicle {
@@ -275,7 +307,10 @@ pub(crate) fn contact_states(
         _ => {
             let gamma = wrap_turns(s.rotation);
             for i in 0..2 {
-                let overlap = s.rail_z[i] - s.wheel_z[i];
+                let mut overlap = s.rail_z[i] - s.wheel_z[i];
+                if let Some(h) = irregularity {
+                    overlap += h[i];
+                }
                 // The force of the step before (what `s` holds) starts the solve.
                 let guess = s.contact[i].force;
                 let p = law.evaluate_in_series_into(

@@ -16,6 +16,7 @@
 //! down on the sleeper; pad damper velocities are backward differences so the rail
 //! update stays explicit; ballast damping uses central differences (3.18).
 
+mod irregularity;
 mod kernels;
 mod observe;
 mod params;
@@ -32,6 +33,7 @@ mod tests;
 mod window;
 
 pub use crate::numerics::SimdLevel;
+pub use irregularity::{MAX_RAIL_IRREGULARITY, RailDefect, RailProfile};
 pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;

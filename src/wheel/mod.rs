@@ -12,9 +12,11 @@
 mod flat;
 mod flatted;
 mod profile;
+mod roundness;
 #[cfg(test)]
 mod tests;
 
 pub use flat::{Flat, FlatShape, FlatSpec};
 pub use flatted::{FlattedWheel, MAX_FLATS};
 pub use profile::WheelProfile;
+pub use roundness::{MAX_RADIUS_DEVIATION, OutOfRoundness};

@@ -10,7 +10,10 @@ use crate::sim::VehicleUnitParams;
 use crate::sim::{
     Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
-use crate::track::{RailBetweenNodes, RailEnds, RailSection, SupportLaw, Supports, TrackParams};
+use crate::track::{
+    RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
+    TrackParams,
+};
 use crate::vehicle::{HalfCarParams, RollPlaneParams};
 use crate::wheel::{FlatShape, FlatSpec};
 
@@ -168,6 +171,7 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         .map(|k| TrailingWheelset {
             offset: val(OFFSET_VRS[k]),
             flats: flats_of(&TRAILING_FLAT_VRS[k]),
+            roundness: Default::default(),
         })
         .collect();
     let sites = SITE_POSITION_VRS[..(val(vr::SITES) as usize).min(SITE_POSITION_VRS.len())]
@@ -224,5 +228,14 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
             sleepers: val(vr::TRACK_VOID_SLEEPERS) as usize,
             gap: val(vr::TRACK_VOID_GAP),
         }),
+        rails: [vr::RAIL_DEFECT_LEFT_DEPTH, vr::RAIL_DEFECT_RIGHT_DEPTH].map(|depth| RailProfile {
+            measured: None,
+            defect: (val(depth) > 0.0).then(|| RailDefect {
+                position: val(vr::RAIL_DEFECT_POSITION),
+                length: val(vr::RAIL_DEFECT_LENGTH),
+                depth: val(depth),
+            }),
+        }),
+        roundness: Default::default(),
     }
 }

@@ -181,7 +181,9 @@ fn contact_output(r: u32) -> Option<(usize, usize, crate::fmu::vars::Quantity)> 
         | Quantity::ContactLength
         | Quantity::ContactMaxForce
         | Quantity::ContactMinForce
-        | Quantity::RailZ => Some((k, side, q)),
+        | Quantity::RailZ
+        | Quantity::WheelAcceleration
+        | Quantity::RailAcceleration => Some((k, side, q)),
         _ => None,
     }
 }
@@ -954,13 +956,16 @@ impl Model for FmuModel {
                 - pick(&law.evaluate(wheel, gamma - e, overlap)))
                 / (2.0 * e)
         };
+        // The wheel's out-of-roundness at the angle that touches the rail moves the
+        // overlap with the axle angle by `dr/d gamma`.
+        let rp = w.radius_deviation_slope(side, gamma);
         // dP/d gamma with the overlap following it through the compliance.
-        let p_gamma = || s * d_gamma(&|c| c.force);
+        let p_gamma = || s * (d_gamma(&|c| c.force) + k * rp);
         // A quantity of the state: a height raises the overlap by `-s` per metre, the
         // axle angle moves it by `-c dP/d gamma`.
         let difference = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
             if which == 2 {
-                d_gamma(pick) - c * p_gamma() * d_overlap(pick)
+                d_gamma(pick) + (rp - c * p_gamma()) * d_overlap(pick)
             } else {
                 -s * d_overlap(pick)
             }
@@ -973,7 +978,7 @@ impl Model for FmuModel {
             Quantity::ContactForce => force(),
             Quantity::ContactOverlap => {
                 if which == 2 {
-                    -c * p_gamma()
+                    rp - c * p_gamma()
                 } else {
                     -s
                 }
@@ -993,6 +998,21 @@ impl Model for FmuModel {
             // steps taken.
             Quantity::ContactMaxForce if p >= w.max_force()[side] => force(),
             Quantity::ContactMinForce if p <= w.min_force()[side] => force(),
+            // Accelerations: `1 / dt^2` of the displacement's derivative (the extremes
+            // are of the steps taken: no feedthrough).
+            Quantity::WheelAcceleration | Quantity::RailAcceleration => {
+                let wheel = q == Quantity::WheelAcceleration;
+                let signal = if wheel { side } else { 2 + side };
+                // The wheel's height moves the wheel one for one, its rotation not; the
+                // rail under the wheel as `rail.*.z`.
+                let dz = match (wheel, which == 2) {
+                    (true, true) => 0.0,
+                    (true, false) => 1.0,
+                    (false, true) => -c * p_gamma(),
+                    (false, false) => c * k * s,
+                };
+                w.acceleration_record().gain(signal, sim.dt()) * dz
+            }
             _ => 0.0,
         })
     }

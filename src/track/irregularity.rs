@@ -1,0 +1,105 @@
+//! The rail's vertical profile along the line: a measured irregularity (height against
+//! position) and a discrete defect of ready shape (a dipped weld or joint), fixed in
+//! line coordinates (an endless track's window reads it where it is).
+
+use crate::error::{Result, out_of_range};
+use crate::numerics::Table;
+use std::f64::consts::TAU;
+
+/// Largest height a measured rail profile or a defect may have either way (m).
+pub const MAX_RAIL_IRREGULARITY: f64 = 0.01;
+
+/// A dipped weld or joint: the rail head dips by `depth` over `length`, centred at
+/// `position`, in the shape of one cosine wave, `-depth (1 + cos(2 pi (x - x_0) /
+/// length)) / 2` for `|x - x_0| < length / 2`: the usual idealisation of a dipped weld
+/// or joint, smooth at its ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RailDefect {
+    /// Centre along the line (m).
+    pub position: f64,
+    /// Length (m), 0.05 to 10.
+    pub length: f64,
+    /// Depth (m, positive down), 0 to [`MAX_RAIL_IRREGULARITY`].
+    pub depth: f64,
+}
+
+impl RailDefect {
+    /// Checks the fields; `name` prefixes their names (`rail.defect`).
+    pub fn validate(&self, name: &str) -> Result<()> {
+        crate::error::finite(&format!("{name}.position"), self.position, "m")?;
+        if !(0.05..=10.0).contains(&self.length) {
+            return Err(out_of_range(
+                &format!("{name}.length"),
+                self.length,
+                "0.05 m <= length <= 10 m",
+            ));
+        }
+        if !(0.0..=MAX_RAIL_IRREGULARITY).contains(&self.depth) {
+            return Err(out_of_range(
+                &format!("{name}.depth"),
+                self.depth,
+                format!("0 m <= depth <= {MAX_RAIL_IRREGULARITY} m"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Height (m, up) and slope at `x` (m).
+    #[inline]
+    fn at(&self, x: f64) -> (f64, f64) {
+        let u = (x - self.position) / self.length;
+        if u.abs() >= 0.5 {
+            return (0.0, 0.0);
+        }
+        let (s, c) = (TAU * u).sin_cos();
+        (
+            -0.5 * self.depth * (1.0 + c),
+            0.5 * self.depth * TAU / self.length * s,
+        )
+    }
+}
+
+/// One rail's vertical profile along the line: the height of its running surface above
+/// the ideal line (m, up), a measured table (position (m) against height (m), the end
+/// heights beyond its ends) plus a discrete defect. It enters the contact where the
+/// wheel touches the rail, as a change of the overlap (a raised rail presses into the
+/// wheel); the track's dynamics are those of the ideal rail loaded there.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RailProfile {
+    /// The measured height.
+    pub measured: Option<std::sync::Arc<Table>>,
+    /// A dipped weld or joint.
+    pub defect: Option<RailDefect>,
+}
+
+impl RailProfile {
+    /// Checks a measured table's heights (at most [`MAX_RAIL_IRREGULARITY`] either way);
+    /// `name` names it in errors.
+    pub fn check_measured(table: &Table, name: &str) -> Result<()> {
+        let (_, h) = table.points();
+        if let Some(&bad) = h.iter().find(|h| h.abs() > MAX_RAIL_IRREGULARITY) {
+            return Err(out_of_range(
+                &format!("{name} (height)"),
+                bad,
+                format!("-{MAX_RAIL_IRREGULARITY} m <= height <= {MAX_RAIL_IRREGULARITY} m"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether the rail has any irregularity.
+    pub fn is_some(&self) -> bool {
+        self.measured.is_some() || self.defect.is_some()
+    }
+
+    /// The height (m, up) and its slope `dh/dx` at `x` (m, line coordinates).
+    #[inline]
+    pub fn at(&self, x: f64) -> (f64, f64) {
+        let (mut h, mut s) = self.defect.map_or((0.0, 0.0), |d| d.at(x));
+        if let Some(t) = &self.measured {
+            h += t.at(x);
+            s += t.slope_at(x);
+        }
+        (h, s)
+    }
+}

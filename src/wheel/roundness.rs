@@ -1,0 +1,74 @@
+//! A measured wheel out-of-roundness: the running surface's radius deviation against
+//! the angle around the wheel (a measured polygonal wheel, a wheel with a tread
+//! defect), on top of the nominal circle and its flats.
+
+use crate::error::{Result, out_of_range};
+use crate::numerics::Table;
+use std::f64::consts::TAU;
+
+/// Largest radius deviation a table may hold (m): beyond a few millimetres a wheel is
+/// no longer a wheel with a measured out-of-roundness.
+pub const MAX_RADIUS_DEVIATION: f64 = 0.005;
+
+/// The radius deviation `r(beta)` (m, positive where the wheel is larger than nominal)
+/// against the wheel angle `beta` (rad): the angle of a point of the running surface
+/// from the downward vertical when the axle rotation is 0, positive ahead, as the flats'
+/// angles are measured (the point at `beta` touches the rail when the axle rotation is
+/// `beta`, `docs/MODEL.md`, "Measured irregularities"). Points joined by straight
+/// lines, once round the wheel: the last point joins the first one a turn later.
+///
+/// The contact sees it where the wheel touches the rail, as a change of the overlap:
+/// the deviation must vary slowly over the contact patch (wavelengths above about ten
+/// patch lengths, 0.1 m); shorter defects are flats.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutOfRoundness {
+    table: Table,
+}
+
+impl OutOfRoundness {
+    /// From a table of wheel angle (rad, `0 <= beta < 2 pi`) against radius deviation
+    /// (m, at most [`MAX_RADIUS_DEVIATION`] either way); `name` names the table in
+    /// errors.
+    pub fn new(table: Table, name: &str) -> Result<Self> {
+        let (first, last) = table.range();
+        if !(first >= 0.0 && last < TAU) {
+            let bad = if first < 0.0 { first } else { last };
+            return Err(out_of_range(
+                &format!("{name} (wheel angle)"),
+                bad,
+                "0 rad <= angle < 2 pi rad",
+            ));
+        }
+        let (_, r) = table.points();
+        if let Some(&bad) = r.iter().find(|r| r.abs() > MAX_RADIUS_DEVIATION) {
+            return Err(out_of_range(
+                &format!("{name} (radius deviation)"),
+                bad,
+                format!("-{MAX_RADIUS_DEVIATION} m <= deviation <= {MAX_RADIUS_DEVIATION} m"),
+            ));
+        }
+        // Once round the wheel: the first point again a turn later.
+        let (b, r) = table.points();
+        let mut angles = b.to_vec();
+        let mut values = r.to_vec();
+        angles.insert(0, b[b.len() - 1] - TAU);
+        values.insert(0, r[r.len() - 1]);
+        angles.push(b[0] + TAU);
+        values.push(r[0]);
+        Ok(OutOfRoundness {
+            table: Table::new(angles, values, name)?,
+        })
+    }
+
+    /// The radius deviation (m) at wheel angle `beta` (rad, any; taken round the wheel).
+    #[inline]
+    pub fn at(&self, beta: f64) -> f64 {
+        self.table.at(beta.rem_euclid(TAU))
+    }
+
+    /// `dr/dbeta` (m/rad) at wheel angle `beta` (rad).
+    #[inline]
+    pub fn slope_at(&self, beta: f64) -> f64 {
+        self.table.slope_at(beta.rem_euclid(TAU))
+    }
+}
