@@ -190,8 +190,20 @@ fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
         let (lo, hi) = table.enum_range(v.get("declaredType").expect("an enumeration's type"));
         write!(line, " min=\"{lo}\" max=\"{hi}\"").unwrap();
     }
+    if v.ty() == "String" {
+        // A String parameter's start, empty as it may be, is required (initial exact).
+        write!(
+            line,
+            " start=\"{}\"",
+            xml_escape(v.a.get("start").map_or("", |s| s))
+        )
+        .unwrap();
+    }
     for k in ["declaredType", "unit", "displayUnit", "start", "min", "max"] {
         if enumeration && k == "declaredType" {
+            continue;
+        }
+        if k == "start" && v.ty() == "String" {
             continue;
         }
         if let Some(x) = v.get(k) {

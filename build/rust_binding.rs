@@ -264,6 +264,7 @@ fn var_spec(rust: &mut String, table: &Table, id: &str, v: &FmuVar) {
         "Real" => "Real",
         "Integer" => "Integer",
         "Enumeration" => "Enumeration",
+        "String" => "String",
         t => panic!("type {t}"),
     };
     let (lo, hi) = if v.ty() == "Enumeration" {

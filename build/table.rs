@@ -317,8 +317,10 @@ fn resolve(id: &str, vars: &[TableVar]) -> Vec<FmuVar> {
         a.insert("variability".into(), variability.into());
         a.insert("initial".into(), initial.unwrap_or("").into());
         if matches!(c.as_str(), "parameter" | "input") {
+            // A String parameter's start may be empty (it is written all the same).
             assert!(
-                a.get("start").is_some_and(|s| !s.is_empty()),
+                a.get("start")
+                    .is_some_and(|s| !s.is_empty() || a["type"] == "String"),
                 "{id}: {} needs a start value",
                 a["name"]
             );

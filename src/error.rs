@@ -56,6 +56,9 @@ pub enum Error {
     },
     /// A request this model does not support.
     Unsupported(String),
+    /// A table (a measured profile) that cannot be read: the parameter, the file or
+    /// line, and what is wrong, in words.
+    Table(String),
     /// An input value the step that would use it refuses (nothing moves).
     Input {
         /// The input's name.
@@ -123,6 +126,7 @@ impl fmt::Display for Error {
                 num(*limit)
             ),
             Error::Unsupported(what) => write!(f, "not supported: {what}"),
+            Error::Table(what) => write!(f, "{what}"),
             Error::Input {
                 name,
                 value,

@@ -175,6 +175,11 @@ def check_variables(study, runner):
             raise ValueError(f"`{name}` is not a parameter or input of CoupledSystem (docs/VARIABLES.md)")
         ty, lo, hi = known[name]
         for v in vs:
+            if (ty == "String") != isinstance(v, str):
+                raise ValueError(f"`{name}` = {v!r}: " + ("a table's path or the table itself (x,y;x,y;...)"
+                                                          if ty == "String" else "a number"))
+            if ty == "String":
+                continue
             if not lo <= v <= hi:
                 raise ValueError(f"`{name}` = {v:g} is out of range: {lo:g} <= {name} <= {hi:g}")
             if ty == "Integer" and v != int(v):

@@ -37,14 +37,14 @@ class Case:
         (16 hex digits of the SHA-1 of ``json.dumps([sorted (name, repr(value)) pairs,
         repr(duration), keep])``)."""
         if self._id is None:
-            text = json.dumps([sorted((k, repr(float(v))) for k, v in self.params.items()),
+            text = json.dumps([sorted((k, _repr(v)) for k, v in self.params.items()),
                                repr(float(self.duration)), list(self.keep)])
             self._id = hashlib.sha1(text.encode()).hexdigest()[:16]
         return self._id
 
     def line(self):
         """The case as the runner reads it."""
-        toks = [f"{k}={float(v)!r}" for k, v in self.params.items()]
+        toks = [f"{k}={v}" if isinstance(v, str) else f"{k}={float(v)!r}" for k, v in self.params.items()]
         toks.append(f"duration={float(self.duration)!r}")
         if self.keep:
             toks.append("keep=" + ",".join(self.keep))
@@ -113,7 +113,7 @@ class Study:
         # json.dumps of the id's list, piece by piece: a float's repr needs no escaping.
         head = {k: "[" + json.dumps(k) + ', "' for k in order}
         rest = "], " + json.dumps(repr(float(self.duration))) + ", " + json.dumps(list(self.keep)) + "]"
-        fixed = {k: repr(float(v)) for k, v in self.fixed.items()}
+        fixed = {k: _repr(v) for k, v in self.fixed.items()}
         keep = tuple(self.keep)
         sha1 = hashlib.sha1
         for row in self._rows():
@@ -130,6 +130,20 @@ class Study:
         :meth:`iter_cases`)."""
         self.check()
         return list(self.iter_cases())
+
+
+def _repr(v):
+    """A value's text in a case's id: a number's float repr, a table's own repr."""
+    return repr(v) if isinstance(v, str) else repr(float(v))
+
+
+def _text(where, v):
+    """A String parameter's value: a table's path, or the table as x,y;x,y;... (the
+    runner's case line splits at blanks, so the value holds none)."""
+    if not v or any(c.isspace() for c in v):
+        raise ValueError(f"{where}: `{v}`: give a table's path without blanks, or the table "
+                         f"itself as x,y;x,y;... without blanks")
+    return v
 
 
 def _number(where, v):
@@ -197,7 +211,7 @@ def _values(name, entry):
         raise ValueError(f"sweep `{name}`: no values")
     f = UNITS[unit]
     # + 0.0 makes -0.0 the 0.0 it is (else the same physics ran as two cases).
-    return [_number(where, v) * f + 0.0 for v in values], unit
+    return [_text(where, v) if isinstance(v, str) else _number(where, v) * f + 0.0 for v in values], unit
 
 
 def load_study(path):
@@ -230,6 +244,8 @@ def load_study(path):
                 raise ValueError(f"fixed `{var}`: a number or {{ value, unit }}")
             unit = _unit(f"fixed `{var}`", entry.get("unit"))
             fixed[var] = _number(f"fixed `{var}`", entry["value"]) * UNITS[unit]
+        elif isinstance(entry, str):
+            fixed[var] = _text(f"fixed `{var}`", entry)
         else:
             fixed[var] = _number(f"fixed `{var}`", entry) + 0.0
     sweep = {}

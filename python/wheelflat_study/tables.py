@@ -105,8 +105,12 @@ def write_tables(study, out_dir, ident=None):
             b"wheelflat.guid.CoupledSystem": json.dumps(sorted(g for g in guids if g)).encode(),
             b"wheelflat.sweep": json.dumps(list(study.sweep)).encode()}
 
+    # The String parameters (tables named by path or given inline) are text too.
+    text = set(TEXT) | {n for n, v in study.fixed.items() if isinstance(v, str)} | {
+        n for n, vs in study.sweep.items() if any(isinstance(x, str) for x in vs)}
+
     def schema(names):
-        fields = [pa.field(n, pa.string() if n in TEXT else pa.int64() if n == "k" else pa.float64())
+        fields = [pa.field(n, pa.string() if n in text else pa.int64() if n == "k" else pa.float64())
                   for n in names]
         return pa.schema(fields, metadata=meta)
 
@@ -125,7 +129,7 @@ def write_tables(study, out_dir, ident=None):
             names, sch = tables[name]
             df = pd.DataFrame(batch[name], columns=names)
             for n in names:
-                if n not in TEXT and n != "k":
+                if n not in text and n != "k":
                     df[n] = df[n].astype("float64")
             writers[name][0].write_table(pa.Table.from_pandas(df, schema=sch, preserve_index=False))
             df.to_csv(writers[name][1], index=False, header=header[name], float_format="%.17g")

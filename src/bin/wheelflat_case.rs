@@ -8,7 +8,8 @@
 //! ```
 //!
 //! A case line holds `NAME=VALUE` tokens: CoupledSystem's parameters and inputs by name
-//! (docs/VARIABLES.md; enumerations by number), `duration=S` (s, required) and
+//! (docs/VARIABLES.md; enumerations by number; a String parameter's table as a path or
+//! as `x,y;x,y;...`, without blanks), `duration=S` (s, required) and
 //! `keep=OUT1,OUT2` (outputs whose extremes to keep), and optionally `case=ID` (letters,
 //! digits, `_`, `.`, `-`; at most 64), the caller's name for the case, which the answer
 //! carries back so that no answer can be taken for another case's. The case runs through the FMU
@@ -43,6 +44,9 @@ use wheelflat::fmu::{Instance, Kind, Logger};
 /// One case: its variables, duration and the outputs to keep.
 struct Case {
     sets: Vec<(String, f64)>,
+    /// String parameters: a table's path, or the table itself (`x,y;x,y;...`: a token
+    /// holds no blank).
+    texts: Vec<(String, String)>,
     duration: f64,
     keep: Vec<String>,
 }
@@ -50,6 +54,7 @@ struct Case {
 fn parse(line: &str) -> Result<Case, String> {
     let mut case = Case {
         sets: Vec::new(),
+        texts: Vec::new(),
         duration: f64::NAN,
         keep: Vec::new(),
     };
@@ -68,6 +73,9 @@ fn parse(line: &str) -> Result<Case, String> {
                     .filter(|s| !s.is_empty())
                     .map(String::from)
                     .collect()
+            }
+            _ if spec(name).is_ok_and(|s| s.ty == VarType::String) => {
+                case.texts.push((name.to_string(), value.to_string()))
             }
             _ => {
                 let x: f64 = value
@@ -159,6 +167,11 @@ fn run(case: &Case) -> Result<String, String> {
         |log: &Arc<Mutex<Vec<String>>>| log.lock().unwrap().last().cloned().unwrap_or_default();
     let fail = |e: wheelflat::fmu::Refusal| e.message;
     inst.setup_experiment(0.0, None).map_err(fail)?;
+    for (name, text) in &case.texts {
+        let s = spec(name)?;
+        inst.set_string(&[s.vr], std::slice::from_ref(text))
+            .map_err(fail)?;
+    }
     for (name, x) in &case.sets {
         let s = spec(name)?;
         if !matches!(s.causality, Causality::Parameter | Causality::Input) {
@@ -412,6 +425,7 @@ fn list_variables() {
         if matches!(v.causality, Causality::Parameter | Causality::Input) {
             let ty = match v.ty {
                 VarType::Real => "Real",
+                VarType::String => "String",
                 _ => "Integer",
             };
             let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}", v.name, v.min, v.max);

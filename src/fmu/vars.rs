@@ -10,6 +10,8 @@ pub enum VarType {
     Integer,
     /// Enumeration, read and written as `fmi2Integer`.
     Enumeration,
+    /// `fmi2String` (a parameter naming a table: its text, or the path of its file).
+    String,
 }
 
 /// Causality of a scalar variable.

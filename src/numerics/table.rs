@@ -47,9 +47,9 @@ impl Table {
         Ok(Table { x, y })
     }
 
-    /// Reads a table from text: one point a line, two numbers separated by blanks, a
-    /// comma or a semicolon; a line may also end a point with `;` so that a whole
-    /// table fits on one line (`0 0; 0.1 1e-5; 0.2 0`). Empty lines and text after `#`
+    /// Reads a table from text: one point a line, two numbers separated by blanks or a
+    /// comma; a `;` also ends a point, so that a whole table fits on one line
+    /// (`0 0; 0.1 1e-5; 0.2 0`, or `0,0;0.1,1e-5;0.2,0` without blanks). Empty lines and text after `#`
     /// are skipped. `name` names the table in errors, with the line.
     pub fn parse(text: &str, name: &str) -> Result<Table> {
         let (mut x, mut y) = (Vec::new(), Vec::new());
@@ -84,9 +84,9 @@ impl Table {
     }
 
     fn bad_line(name: &str, n: usize, point: &str) -> Error {
-        Error::Unsupported(format!(
-            "{name}: line {}: `{}` is not two numbers (x y, separated by blanks, a comma \
-             or a semicolon)",
+        Error::Table(format!(
+            "{name}: line {}: `{}` is not two numbers (x y, separated by blanks or a comma; \
+             a `;` or a line break between points)",
             n + 1,
             point.trim().chars().take(80).collect::<String>()
         ))
@@ -144,7 +144,7 @@ mod tests {
 
     #[test]
     fn a_table_reads_lines_or_one_line_and_joins_its_points_by_straight_lines() {
-        let t = Table::parse("# x y\n0 0\n1, 2\n\n3;4  # end\n", "t").unwrap();
+        let t = Table::parse("# x y\n0 0\n1, 2\n\n3 4  # end\n", "t").unwrap();
         assert_eq!(t, Table::parse("0 0; 1 2; 3 4", "t").unwrap());
         assert_eq!(t.at(0.5), 1.0);
         assert_eq!(t.at(2.0), 3.0);

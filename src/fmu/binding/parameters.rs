@@ -3,9 +3,11 @@
 
 use super::Kind;
 use crate::contact::ContactModel;
+use crate::error::Error;
 use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
+use crate::numerics::Table;
 use crate::sim::VehicleUnitParams;
 use crate::sim::{
     Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
@@ -15,7 +17,8 @@ use crate::track::{
     TrackParams,
 };
 use crate::vehicle::{HalfCarParams, RollPlaneParams};
-use crate::wheel::{FlatShape, FlatSpec};
+use crate::wheel::{FlatShape, FlatSpec, OutOfRoundness};
+use std::sync::Arc;
 
 /// Track parameters (fixed rail ends).
 pub fn track_params(v: &[f64]) -> TrackParams {
@@ -238,4 +241,69 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         }),
         roundness: Default::default(),
     }
+}
+
+/// The table a String parameter `name` names in `text`: none for an empty text, the
+/// text itself when it holds a `;` or a line break (`0 0; 0.1 2e-5; ...`), else the
+/// file at that path (absolute, or relative to the working directory of the process
+/// that loaded the FMU), read by [`Table::parse`].
+///
+/// Errors: a file that cannot be read, or text that is not a table, naming `name`.
+pub fn read_table(name: &str, text: &str) -> Result<Option<Table>, Error> {
+    let text = text.trim();
+    if text.is_empty() {
+        return Ok(None);
+    }
+    if text.contains(';') || text.contains('\n') {
+        return Table::parse(text, name).map(Some);
+    }
+    let content = std::fs::read_to_string(text).map_err(|e| {
+        Error::Table(format!(
+            "{name} = {text:?}: cannot read the table's file ({e}); give a path (absolute, \
+             or relative to the working directory) or the table itself (`x y; x y; ...`)"
+        ))
+    })?;
+    Table::parse(&content, &format!("{name} ({text})")).map(Some)
+}
+
+/// Checks the String parameter `name`'s value `text` as the model will read it: a rail
+/// profile's heights, a wheel's out-of-roundness angles and deviations.
+pub fn check_table(name: &str, text: &str) -> Result<(), Error> {
+    match read_table(name, text)? {
+        None => Ok(()),
+        Some(t) if name.ends_with(".out_of_roundness") => OutOfRoundness::new(t, name).map(|_| ()),
+        Some(t) => RailProfile::check_measured(&t, name),
+    }
+}
+
+/// `s` with the tables the String parameters `strings` (by value reference) name: the
+/// rails' measured profiles and the wheels' out-of-roundness.
+pub fn with_tables(mut s: Scenario, strings: &[String]) -> Result<Scenario, Error> {
+    let text = |name: &str| -> &str {
+        crate::fmu::vars::COUPLED_SYSTEM
+            .vars
+            .iter()
+            .find(|v| v.name == name)
+            .map_or("", |v| strings[v.vr as usize].as_str())
+    };
+    let wheel = |name: String| -> Result<Option<Arc<OutOfRoundness>>, Error> {
+        match read_table(&name, text(&name))? {
+            None => Ok(None),
+            Some(t) => Ok(Some(Arc::new(OutOfRoundness::new(t, &name)?))),
+        }
+    };
+    for (side, rail) in ["left", "right"].iter().zip(&mut s.rails) {
+        let name = format!("rail.{side}.profile");
+        if let Some(t) = read_table(&name, text(&name))? {
+            RailProfile::check_measured(&t, &name)?;
+            rail.measured = Some(Arc::new(t));
+        }
+    }
+    for (i, side) in ["left", "right"].iter().enumerate() {
+        s.roundness[i] = wheel(format!("wheel.{side}.out_of_roundness"))?;
+        for (k, w) in s.trailing.iter_mut().enumerate() {
+            w.roundness[i] = wheel(format!("wheelset[{}].wheel.{side}.out_of_roundness", k + 2))?;
+        }
+    }
+    Ok(s)
 }

@@ -5,7 +5,7 @@
 use super::Kind;
 use super::datum::InputDatum;
 use super::outputs::Published;
-use super::parameters::{scenario, vehicle_unit_params};
+use super::parameters::{check_table, scenario, vehicle_unit_params, with_tables};
 use super::watch::{ContactWatch, HELD_STEPS, INTERPOLATED_STEPS};
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
@@ -290,7 +290,11 @@ impl FmuModel {
 impl Model for FmuModel {
     const CALCULATED: usize = Published::LEN;
 
-    fn build(table: &'static FmuTable, values: &[f64]) -> Result<Self, Error> {
+    fn check_string(spec: &crate::fmu::vars::VarSpec, value: &str) -> Result<(), Error> {
+        check_table(spec.name, value)
+    }
+
+    fn build(table: &'static FmuTable, values: &[f64], strings: &[String]) -> Result<Self, Error> {
         let kind = Kind::from_guid(table.guid).ok_or_else(|| {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
         })?;
@@ -315,7 +319,7 @@ impl Model for FmuModel {
                 (Engine::Vehicle(Box::new(u)), published)
             }
             Kind::TrackContact | Kind::CoupledSystem => {
-                let sim = Simulation::new(&scenario(kind, values))?;
+                let sim = Simulation::new(&with_tables(scenario(kind, values), strings)?)?;
                 let mut trailing_static_wheel_z = [[0.0; 2]; TRAILING];
                 for (z, k) in trailing_static_wheel_z.iter_mut().zip(1..) {
                     if let Some(s) = sim.sample_of(k) {

@@ -270,7 +270,8 @@ pub unsafe extern "C" fn fmi2GetBoolean(
     })
 }
 
-/// `fmi2GetString`: no String variables.
+/// `fmi2GetString`: the String parameters; the strings stay valid until the next
+/// `fmi2GetString` of this instance (or its freeing).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetString(
     c: fmi2Component,
@@ -281,8 +282,18 @@ pub unsafe extern "C" fn fmi2GetString(
     let call = Call::GetString;
     with(c, call, |i| {
         let vr = slice(i, call, "vr", vr, nvr)?;
-        slice_mut(i, call, "value", value, nvr)?;
-        i.no_such_type(call.name(), vr)
+        let out = slice_mut(i, call, "value", value, nvr)?;
+        let texts = i.get_string(vr)?;
+        // The values hold no NUL: fmi2SetString took them from C strings.
+        let buffers: Vec<std::ffi::CString> = texts
+            .into_iter()
+            .map(|t| std::ffi::CString::new(t).unwrap_or_default())
+            .collect();
+        for (slot, b) in out.iter_mut().zip(&buffers) {
+            *slot = b.as_ptr();
+        }
+        i.keep_string_buffers(buffers);
+        Ok(())
     })
 }
 
@@ -340,7 +351,7 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     })
 }
 
-/// `fmi2SetString`: no String variables.
+/// `fmi2SetString`: the String parameters (UTF-8 text; a null string is refused).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetString(
     c: fmi2Component,
@@ -351,8 +362,27 @@ pub unsafe extern "C" fn fmi2SetString(
     let call = Call::SetString;
     with(c, call, |i| {
         let vr = slice(i, call, "vr", vr, nvr)?;
-        slice(i, call, "value", value, nvr)?;
-        i.no_such_type(call.name(), vr)
+        let value = slice(i, call, "value", value, nvr)?;
+        let mut texts = Vec::with_capacity(nvr);
+        for (k, &p) in value.iter().enumerate() {
+            if p.is_null() {
+                return i.refuse(
+                    Status::Error,
+                    format!("fmi2SetString: argument `value[{k}]` is a null pointer"),
+                );
+            }
+            // SAFETY: a non-null fmi2String is a NUL-terminated C string (FMI 2.0).
+            match unsafe { std::ffi::CStr::from_ptr(p) }.to_str() {
+                Ok(t) => texts.push(t.to_string()),
+                Err(_) => {
+                    return i.refuse(
+                        Status::Error,
+                        format!("fmi2SetString: `value[{k}]` is not UTF-8 text"),
+                    );
+                }
+            }
+        }
+        i.set_string(vr, &texts)
     })
 }
 

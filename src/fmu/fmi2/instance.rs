@@ -16,6 +16,11 @@ pub struct Instance<M: Model> {
     pub(super) slot: Vec<Option<usize>>,
     /// Current values of parameters and inputs, by value reference.
     pub(super) values: Vec<f64>,
+    /// Current values of the String parameters, by value reference (empty for every
+    /// other reference).
+    pub(super) strings: Vec<String>,
+    /// The C strings of the last `fmi2GetString`, alive until the next call.
+    pub(super) string_buffers: Vec<std::ffi::CString>,
     pub(super) phase: Phase,
     pub(super) model: Option<M>,
     /// Parameters changed since the model was built.
@@ -69,6 +74,8 @@ impl<M: Model> Instance<M> {
             name: name.to_string(),
             slot,
             values,
+            strings: vec![String::new(); N_VR],
+            string_buffers: Vec::new(),
             phase: Phase::Instantiated,
             model: None,
             dirty: true,
@@ -110,6 +117,14 @@ impl<M: Model> Instance<M> {
     /// The current value of a parameter or input (NaN for any other value reference).
     pub fn value(&self, vr: u32) -> f64 {
         self.values.get(vr as usize).copied().unwrap_or(f64::NAN)
+    }
+    /// Keeps the C strings `fmi2GetString` handed out until the next call.
+    pub fn keep_string_buffers(&mut self, buffers: Vec<std::ffi::CString>) {
+        self.string_buffers = buffers;
+    }
+    /// The value of a String parameter (empty for any other value reference).
+    pub fn string(&self, vr: u32) -> &str {
+        self.strings.get(vr as usize).map_or("", |s| s.as_str())
     }
     /// The values of the parameters and inputs, by value reference.
     pub fn values(&self) -> &[f64] {
@@ -333,6 +348,7 @@ impl<M: Model> Instance<M> {
         for v in self.table.vars {
             self.values[v.vr as usize] = v.start;
         }
+        self.strings.iter_mut().for_each(String::clear);
         self.phase = Phase::Instantiated;
         self.model = None;
         self.dirty = true;
@@ -361,7 +377,7 @@ impl<M: Model> Instance<M> {
     pub(super) fn ensure_model(&mut self) -> FmiResult {
         if self.model.is_none() || self.dirty {
             let old = self.model.take();
-            match M::build(self.table, &self.values) {
+            match M::build(self.table, &self.values, &self.strings) {
                 Ok(m) => {
                     self.calculated = m.calculated();
                     self.model = Some(m);

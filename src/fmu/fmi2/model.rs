@@ -58,7 +58,15 @@ pub trait Model: Clone + Sized {
     /// its initial state.
     ///
     /// Errors: any parameter the model refuses, named with its value and allowed range.
-    fn build(table: &'static FmuTable, values: &[f64]) -> Result<Self, Error>;
+    /// `strings[vr]` holds the String parameters' values (empty for the others).
+    fn build(table: &'static FmuTable, values: &[f64], strings: &[String]) -> Result<Self, Error>;
+    /// Checks the value of the String parameter `spec` when it is set: the earliest
+    /// call that can know it is bad.
+    ///
+    /// Errors: a value the model refuses, named with the variable.
+    fn check_string(_spec: &VarSpec, _value: &str) -> Result<(), Error> {
+        Ok(())
+    }
 
     /// The calculated parameters (fixed by [`Model::build`]), in the order FMU states
     /// store them; [`Model::CALCULATED`] values.

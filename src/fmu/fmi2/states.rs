@@ -6,7 +6,7 @@ use super::calls::{Call, Phase};
 use super::instance::Instance;
 use super::model::Model;
 use super::status::{FmiResult, Status};
-use crate::fmu::vars::{Causality, FmuTable, N_VR};
+use crate::fmu::vars::{Causality, FmuTable, N_VR, VarType};
 
 /// Everything an FMU state holds: enough to continue bit-identically.
 #[derive(Debug, Clone)]
@@ -14,6 +14,8 @@ pub struct Snapshot<M> {
     table: &'static FmuTable,
     phase: Phase,
     values: Vec<f64>,
+    /// The String parameters, by value reference.
+    strings: Vec<String>,
     model: Option<M>,
     calculated: Vec<f64>,
     time: f64,
@@ -24,7 +26,7 @@ pub struct Snapshot<M> {
 }
 
 /// The start of every serialized state.
-pub(crate) const MAGIC: &[u8] = b"wheelflat-fmu-state-2\0";
+pub(crate) const MAGIC: &[u8] = b"wheelflat-fmu-state-3\0";
 
 impl<M: Model> Instance<M> {
     /// `fmi2GetFMUstate`.
@@ -35,6 +37,7 @@ impl<M: Model> Instance<M> {
             table: self.table,
             phase: self.phase,
             values: self.values.clone(),
+            strings: self.strings.clone(),
             model: self.model.clone(),
             calculated: self.calculated.clone(),
             time: self.time,
@@ -57,6 +60,7 @@ impl<M: Model> Instance<M> {
         }
         self.phase = s.phase;
         self.values.clone_from(&s.values);
+        self.strings.clone_from(&s.strings);
         self.model.clone_from(&s.model);
         self.dirty = self.model.is_none();
         self.calculated.clone_from(&s.calculated);
@@ -70,7 +74,8 @@ impl<M: Model> Instance<M> {
     }
 
     /// `fmi2SerializeFMUstate`: magic, GUID, phase, clock, reason of a stopped run,
-    /// calculated parameters, values, model state.
+    /// calculated parameters, values, the String parameters that are set (value
+    /// reference, length, UTF-8 bytes), model state.
     pub fn serialize(&mut self, s: &Snapshot<M>) -> FmiResult<Vec<u8>> {
         let model = match s.model.as_ref().map(M::state_vector) {
             None => Vec::new(),
@@ -96,6 +101,18 @@ impl<M: Model> Instance<M> {
         b.extend_from_slice(&(s.values.len() as u64).to_le_bytes());
         for x in &s.values {
             b.extend_from_slice(&x.to_le_bytes());
+        }
+        let set: Vec<(usize, &String)> = s
+            .strings
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| !t.is_empty())
+            .collect();
+        b.extend_from_slice(&(set.len() as u64).to_le_bytes());
+        for (r, t) in set {
+            b.extend_from_slice(&(r as u64).to_le_bytes());
+            b.extend_from_slice(&(t.len() as u64).to_le_bytes());
+            b.extend_from_slice(t.as_bytes());
         }
         b.extend_from_slice(&(model.len() as u64).to_le_bytes());
         for x in &model {
@@ -134,7 +151,9 @@ impl<M: Model> Instance<M> {
         }
         for v in self.table.vars {
             let x = values[v.vr as usize];
-            let known = matches!(v.causality, Causality::Parameter | Causality::Input);
+            // A String parameter's value is its text, stored apart (NaN here).
+            let known = matches!(v.causality, Causality::Parameter | Causality::Input)
+                && v.ty != VarType::String;
             if known && !(x.is_finite() && x >= v.min && x <= v.max) {
                 return Err(format!(
                     "stored `{}` = {x} is out of range (finite, {} to {})",
@@ -199,6 +218,30 @@ impl<M: Model> Instance<M> {
         for _ in 0..nv {
             values.push(r.f64()?);
         }
+        let mut strings = vec![String::new(); N_VR];
+        let ns = r.u64()? as usize;
+        if ns > N_VR {
+            return Err(format!("{ns} String values; this FMU has at most {N_VR}"));
+        }
+        for _ in 0..ns {
+            let vr = r.u64()? as usize;
+            let is_string = self
+                .slot
+                .get(vr)
+                .copied()
+                .flatten()
+                .is_some_and(|i| self.table.vars[i].ty == VarType::String);
+            if !is_string {
+                return Err(format!(
+                    "stored value reference {vr} is no String parameter"
+                ));
+            }
+            let len = r.u64()? as usize;
+            let text = r.take(len)?;
+            strings[vr] = std::str::from_utf8(text)
+                .map_err(|_| format!("stored String value of reference {vr} is not UTF-8"))?
+                .to_string();
+        }
         let nm = r.u64()? as usize;
         if nm > bytes.len() / 8 {
             return Err(format!("model state length {nm} exceeds the data"));
@@ -224,7 +267,7 @@ impl<M: Model> Instance<M> {
         self.check_stored((time, start_time), &calculated, &values, &state)?;
         let model = if has_model && !stopped {
             // Build with the stored parameters, then overwrite the dynamic state.
-            let mut m = M::build(self.table, &values)
+            let mut m = M::build(self.table, &values, &strings)
                 .map_err(|e| format!("stored parameters refused: {e}"))?;
             let again = m.calculated();
             if let Some(k) =
@@ -254,6 +297,7 @@ impl<M: Model> Instance<M> {
             table: self.table,
             phase,
             values,
+            strings,
             model,
             calculated,
             time,

@@ -29,7 +29,7 @@ impl<M: Model> Instance<M> {
 
     fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
         let is_real = s.ty == VarType::Real;
-        if is_real != real {
+        if is_real != real || s.ty == VarType::String {
             return self.refuse(
                 Status::Error,
                 format!(
@@ -40,6 +40,7 @@ impl<M: Model> Instance<M> {
                         VarType::Real => "Real",
                         // Written as Integer in the model descriptions.
                         VarType::Integer | VarType::Enumeration => "Integer",
+                        VarType::String => "String",
                     }
                 ),
             );
@@ -278,6 +279,74 @@ impl<M: Model> Instance<M> {
 
     /// Boolean and String access for an FMU without such variables: any value
     /// reference is unknown (an empty request succeeds).
+    /// `fmi2SetString`: String parameters, in the phases parameters are set; each
+    /// value checked by the model ([`Model::check_string`]) before any is stored.
+    pub fn set_string(&mut self, vrs: &[u32], vals: &[String]) -> FmiResult {
+        let call = Call::SetString;
+        self.check(call)?;
+        let name = call.name();
+        for (&r, v) in vrs.iter().zip(vals) {
+            let s = self.spec(name, r)?;
+            if s.ty != VarType::String {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{name}: variable `{}` (value reference {}) is not of type String",
+                        s.name, s.vr
+                    ),
+                );
+            }
+            if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{name}: variable `{}` (Parameter) cannot be set in state {:?}; \
+                         parameters are fixed after initialisation (use fmi2Reset)",
+                        s.name, self.phase
+                    ),
+                );
+            }
+            if let Err(e) = M::check_string(s, v) {
+                return self.refuse(Status::Error, format!("{name}: {e}"));
+            }
+        }
+        for (&r, v) in vrs.iter().zip(vals) {
+            self.log_call(|| {
+                format!(
+                    "{name}(vr={r}, value={:?})",
+                    v.chars().take(200).collect::<String>()
+                )
+            });
+            if self.strings[r as usize] != *v {
+                self.strings[r as usize] = v.clone();
+                self.dirty = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// `fmi2GetString`: the String parameters' values.
+    pub fn get_string(&mut self, vrs: &[u32]) -> FmiResult<Vec<String>> {
+        let call = Call::GetString;
+        self.check(call)?;
+        let name = call.name();
+        let mut out = Vec::with_capacity(vrs.len());
+        for &r in vrs {
+            let s = self.spec(name, r)?;
+            if s.ty != VarType::String {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{name}: variable `{}` (value reference {}) is not of type String",
+                        s.name, s.vr
+                    ),
+                );
+            }
+            out.push(self.strings[r as usize].clone());
+        }
+        Ok(out)
+    }
+
     pub fn no_such_type(&mut self, call: &str, vrs: &[u32]) -> FmiResult {
         match vrs.first() {
             None => Ok(()),
