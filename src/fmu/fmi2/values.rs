@@ -27,25 +27,33 @@ impl<M: Model> Instance<M> {
         &self.table.vars[self.slot[r as usize].unwrap_or_default()]
     }
 
+    #[inline(always)]
     fn check_type(&mut self, call: &str, s: &VarSpec, real: bool) -> FmiResult {
-        let is_real = s.ty == VarType::Real;
-        if is_real != real || s.ty == VarType::String {
-            return self.refuse(
-                Status::Error,
-                format!(
-                    "{call}: variable `{}` (value reference {}) is of type {}",
-                    s.name,
-                    s.vr,
-                    match s.ty {
-                        VarType::Real => "Real",
-                        // Written as Integer in the model descriptions.
-                        VarType::Integer | VarType::Enumeration => "Integer",
-                        VarType::String => "String",
-                    }
-                ),
-            );
-        }
-        Ok(())
+        let fits = match s.ty {
+            VarType::Real => real,
+            VarType::Integer | VarType::Enumeration => !real,
+            VarType::String => false,
+        };
+        if fits { Ok(()) } else { self.wrong_type(call, s) }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn wrong_type(&mut self, call: &str, s: &VarSpec) -> FmiResult {
+        self.refuse(
+            Status::Error,
+            format!(
+                "{call}: variable `{}` (value reference {}) is of type {}",
+                s.name,
+                s.vr,
+                match s.ty {
+                    VarType::Real => "Real",
+                    // Written as Integer in the model descriptions.
+                    VarType::Integer | VarType::Enumeration => "Integer",
+                    VarType::String => "String",
+                }
+            ),
+        )
     }
 
     /// Reads variables into `out` (Real or Integer/Enumeration by `real`). Outputs and
