@@ -41,7 +41,10 @@ fn main() {
             let (x, h): (Vec<f64>, Vec<f64>) = (0..=1000)
                 .map(|i| {
                     let x = 0.02 * i as f64;
-                    (x, -1e-3 * (1.0 + (TAU * (x - 8.5)).cos()) * f64::from((x - 8.5).abs() < 0.5))
+                    (
+                        x,
+                        -1e-3 * (1.0 + (TAU * (x - 8.5)).cos()) * f64::from((x - 8.5).abs() < 0.5),
+                    )
                 })
                 .unzip();
             s.rails[0].measured = Some(Arc::new(Table::new(x, h, "profile").unwrap()));

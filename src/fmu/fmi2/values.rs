@@ -34,7 +34,11 @@ impl<M: Model> Instance<M> {
             VarType::Integer | VarType::Enumeration => !real,
             VarType::String => false,
         };
-        if fits { Ok(()) } else { self.wrong_type(call, s) }
+        if fits {
+            Ok(())
+        } else {
+            self.wrong_type(call, s)
+        }
     }
 
     #[cold]
