@@ -73,3 +73,34 @@ def test_the_flats_impact_shakes_the_wheel_and_the_rail(run):
     wheel, rail = np.abs(r["wheel.left.acceleration"]).max(), np.abs(r["rail.left.acceleration"]).max()
     other = np.abs(r["wheel.right.acceleration"]).max()
     assert 100 < wheel < 5e3 and rail > 5 * wheel and other < 0.5 * wheel, (wheel, rail, other)
+
+
+def test_the_vehicle_fmu_measures_its_wheels_as_coupled_system_does(run):
+    # TrackContact + RollPlaneVehicle at the track's step reproduce CoupledSystem; the
+    # vehicle's own wheel accelerations (its heights' second difference at its steps)
+    # and TrackContact's (of the heights it is given) are CoupledSystem's.
+    r, h = run
+    paths = {n: os.path.join(wf.FMU_DIR, n + ".fmu") for n in ("TrackContact", "RollPlaneVehicle")}
+    track, vehicle = wf.Unit(paths["TrackContact"], "track"), wf.Unit(paths["RollPlaneVehicle"], "vehicle")
+    wheels = ["wheel.left.z", "wheel.right.z", "wheel.rotation"]
+    names = ["wheel.left.acceleration", "wheel.right.acceleration", "wheel.left.acceleration.min"]
+    try:
+        wf.initialise_pair(track, vehicle)
+        got_vehicle, got_track = [], []
+        t = 0.0
+        for k in range(len(r["time"])):
+            track.set(wheels, vehicle.get(*wheels))
+            vehicle.set(["contact.left.force", "contact.right.force"],
+                        track.get("contact.left.force", "contact.right.force"))
+            got_vehicle.append(vehicle.get(*names))
+            got_track.append(track.get(*names))
+            track.fmu.doStep(t, h)
+            vehicle.fmu.doStep(t, h)
+            t = (k + 1) * h
+    finally:
+        track.close()
+        vehicle.close()
+    want = np.array([r[n] for n in names]).T
+    scale = np.abs(want).max()
+    for got in (np.array(got_vehicle), np.array(got_track)):
+        assert np.abs(got - want).max() < 1e-6 * scale, np.abs(got - want).max() / scale

@@ -8,6 +8,7 @@
 //! both step), the pair performs exactly the arithmetic of the monolithic
 //! [`crate::sim::Simulation`].
 
+use super::accelerations::Accelerations;
 use super::clock::{Clock, ForceExtremes, StepPlan, Stepping};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{
@@ -89,6 +90,8 @@ pub struct VehicleUnit {
     /// with the axle-box interface.
     rest: Quad,
     extremes: [ForceExtremes; 2],
+    /// The wheels' accelerations of each wheelset (the rail signals unused).
+    accelerations: [Accelerations; 2],
     /// The axle rotation (rad) at `since` (s), from which it turns at the speed held
     /// since ([`VehicleUnit::set_speed`]).
     rotation_ref: f64,
@@ -181,6 +184,7 @@ impl VehicleUnit {
             force,
             rest: force,
             extremes: force.map(ForceExtremes::at),
+            accelerations: [Accelerations::NONE; 2],
             rotation_ref: 0.0,
             since: 0.0,
             exchange: None,
@@ -406,6 +410,19 @@ impl VehicleUnit {
     pub fn forces(&self) -> [f64; 2] {
         self.force[0]
     }
+    /// The vertical accelerations of wheelset `k`'s wheels `[left, right]` (m/s^2)
+    /// now, with their largest and smallest of the steps taken: the second difference
+    /// of the wheel heights at the unit's steps ([`Accelerations`]); zeros with the
+    /// axle-box interface (the partner carries the wheelsets).
+    pub fn wheel_accelerations(&self, k: usize) -> [[f64; 2]; 3] {
+        let Some(z) = self.wheel_z_of(k) else {
+            return [[0.0; 2]; 3];
+        };
+        let a = &self.accelerations[k.min(1)];
+        let now = a.now([z[0], z[1], 0.0, 0.0], self.clock.dt);
+        [now, a.max(now), a.min(now)].map(|x| [x[0], x[1]])
+    }
+
     /// Largest contact force per wheel of wheelset `k` that has driven a step (N); the
     /// static load before the first step.
     pub fn max_force_of(&self, k: usize) -> [f64; 2] {
@@ -541,10 +558,21 @@ impl VehicleUnit {
             self.extremes[k].record(self.force[k]);
         }
         let n = s.n as u64;
+        let dt = self.clock.dt;
         match &mut self.body {
-            Body::RollPlane(v) => (0..n).for_each(|_| v.step(self.force[0])),
+            Body::RollPlane(v) => (0..n).for_each(|_| {
+                // The wheels at the start of each step, as the engine samples them.
+                let z = v.wheel_z();
+                self.accelerations[0].record([z[0], z[1], 0.0, 0.0], dt);
+                v.step(self.force[0])
+            }),
             Body::Sprung { bogie, .. } => (0..n).for_each(|_| bogie.step(self.force[0])),
-            Body::HalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
+            Body::HalfCar(b) => (0..n).for_each(|_| {
+                for (a, z) in self.accelerations.iter_mut().zip(b.wheel_z()) {
+                    a.record([z[0], z[1], 0.0, 0.0], dt);
+                }
+                b.step(self.force)
+            }),
             Body::SprungHalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
         }
         for _ in 0..n {
@@ -656,14 +684,15 @@ impl VehicleUnit {
     /// rotation at the last change of speed, its time), then per wheelset the held
     /// forces (2) and the extremes.
     fn head_len(&self) -> usize {
-        6 + self.wheelsets() * (2 + ForceExtremes::LEN)
+        6 + self.wheelsets() * (2 + ForceExtremes::LEN + Accelerations::LEN)
     }
 
     /// Everything that determines the continuation: the clock (`t0` (s), `k`, the
     /// carried time (s)), the motion (the speed (m/s), the rotation (rad) at its last
     /// change and that time (s)), the held forces `[left, right]` (N) of each wheelset, the
-    /// largest and smallest forces `[left, right]` (N) of each, then the vehicle's step
-    /// and displacements; [`VehicleUnit::set_state_vector`] restores it exactly.
+    /// largest and smallest forces `[left, right]` (N) of each, the wheels'
+    /// accelerations' history and extremes of each ([`Accelerations`]), then the
+    /// vehicle's step and displacements; [`VehicleUnit::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let c = &self.clock;
         let n = self.wheelsets();
@@ -678,6 +707,9 @@ impl VehicleUnit {
         v.extend(self.force[..n].iter().flatten());
         for e in &self.extremes[..n] {
             v.extend(e.to_array());
+        }
+        for a in &self.accelerations[..n] {
+            v.extend(a.to_array());
         }
         v.extend(self.body_state());
         v
@@ -749,6 +781,16 @@ impl VehicleUnit {
             self.force[k] = [v[6 + 2 * k], v[7 + 2 * k]];
             let e = 6 + 2 * n + ForceExtremes::LEN * k;
             self.extremes[k] = ForceExtremes::from_slice(&v[e..e + ForceExtremes::LEN]);
+            let a = 6 + n * (2 + ForceExtremes::LEN) + Accelerations::LEN * k;
+            let a = &v[a..a + Accelerations::LEN];
+            if let Some(&bad) = a.iter().find(|x| !x.is_finite()) {
+                return Err(out_of_range(
+                    "vehicle unit state: accelerations",
+                    bad,
+                    "finite",
+                ));
+            }
+            self.accelerations[k] = Accelerations::from_slice(a);
         }
         self.check_states()
     }

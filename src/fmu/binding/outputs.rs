@@ -95,6 +95,8 @@ impl FmuModel {
                 .wheelsets()
                 .get(index)
                 .map_or(0.0, |w| w.accelerations(s, sim.dt())[which][signal]),
+            // The vehicles carry the wheels, not the rail.
+            View::Vehicle(u) if signal < 2 => u.wheel_accelerations(index)[which][signal],
             View::Vehicle(_) => f64::NAN,
         };
         // The discrete track of a track-carrying model.
