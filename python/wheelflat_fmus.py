@@ -94,9 +94,12 @@ class Unit:
         self.fmu.setReal([self.vr[n] for n in names], list(values))
 
     def set_parameters(self, params):
-        """Sets parameters by name (Real, or Integer/Enumeration by their declared type)."""
+        """Sets parameters by name (Real, Integer/Enumeration, or String: a table's text
+        or path, by their declared type)."""
         for name, value in (params or {}).items():
-            if self.types[name] in ("Integer", "Enumeration"):
+            if self.types[name] == "String":
+                self.fmu.setString([self.vr[name]], [str(value)])
+            elif self.types[name] in ("Integer", "Enumeration"):
                 self.fmu.setInteger([self.vr[name]], [int(value)])
             else:
                 self.fmu.setReal([self.vr[name]], [float(value)])

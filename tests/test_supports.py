@@ -93,7 +93,7 @@ def test_hanging_sleepers_on_the_endless_track_close_their_gap_under_the_wheel(c
 @pytest.mark.parametrize("start, message", [
     # A gap above the table's range, refused when it is set.
     ({"track.void.gap": 0.1},
-     "`track.void.gap` = 0.1 m is out of range; allowed: finite, 0 <= track.void.gap <= 0.05 m"),
+     "`track.void.gap` = 0.1 m is out of range; allowed: finite, 0 <= track.void.gap <= 0.01 m"),
     # Hanging sleepers beyond the fixed track's 31 sleepers, refused at initialisation.
     ({"track.void.sleepers": 3, "track.void.position": 50.0},
      "parameter `track.void.position` = 50 is out of range: allowed a run of track.void.sleepers = 3 "

@@ -179,6 +179,10 @@ def check_variables(study, runner):
                 raise ValueError(f"`{name}` = {v!r}: " + ("a table's path or the table itself (x,y;x,y;...)"
                                                           if ty == "String" else "a number"))
             if ty == "String":
+                from .spec import inline
+                if not inline(v) and not os.path.isfile(v):
+                    raise ValueError(f"`{name}` = {v!r}: no such file (a relative path is taken from "
+                                     f"the study file's folder)")
                 continue
             if not lo <= v <= hi:
                 raise ValueError(f"`{name}` = {v:g} is out of range: {lo:g} <= {name} <= {hi:g}")

@@ -4,6 +4,7 @@ import hashlib
 import itertools
 import json
 import math
+import os
 import random
 import re
 import tomllib
@@ -137,6 +138,20 @@ def _repr(v):
     return repr(v) if isinstance(v, str) else repr(float(v))
 
 
+def inline(v):
+    """Whether a String parameter's value is the table itself (it holds a `;` or a line
+    break), not its file's path."""
+    return ";" in v or "\n" in v
+
+
+def _path_from(base, v):
+    """A table's path `v` taken from the folder `base` when relative; other values as
+    they are."""
+    if isinstance(v, str) and not inline(v) and not os.path.isabs(v):
+        return os.path.normpath(os.path.join(base, v))
+    return v
+
+
 def _text(where, v):
     """A String parameter's value: a table's path, or the table as x,y;x,y;... (the
     runner's case line splits at blanks, so the value holds none)."""
@@ -248,11 +263,16 @@ def load_study(path):
             fixed[var] = _text(f"fixed `{var}`", entry)
         else:
             fixed[var] = _number(f"fixed `{var}`", entry) + 0.0
+    # A table's relative path is the study file's: the runners may run elsewhere.
+    base = os.path.dirname(os.path.abspath(path))
+    for var, v in fixed.items():
+        fixed[var] = _path_from(base, v)
     sweep = {}
     for var, entry in d.get("sweep", {}).items():
         if var in fixed:
             raise ValueError(f"`{var}` is both fixed and swept")
         sweep[var], unit = _values(var, entry)
+        sweep[var] = [_path_from(base, v) for v in sweep[var]]
         if unit:
             display[var] = (unit, 1 / UNITS[unit])
     combine = d.get("combine", "product")

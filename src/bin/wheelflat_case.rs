@@ -78,9 +78,12 @@ fn parse(line: &str) -> Result<Case, String> {
                 case.texts.push((name.to_string(), value.to_string()))
             }
             _ => {
-                let x: f64 = value
-                    .parse()
-                    .map_err(|_| format!("`{name}`: `{value}` is not a number"))?;
+                let x: f64 = value.parse().map_err(|_| match (name, spec(name)) {
+                    ("duration", _) | (_, Ok(_)) => {
+                        format!("`{name}`: `{value}` is not a number")
+                    }
+                    (_, Err(e)) => e,
+                })?;
                 if name == "duration" {
                     case.duration = x;
                 } else {

@@ -52,10 +52,17 @@ impl Table {
     /// (`0 0; 0.1 1e-5; 0.2 0`, or `0,0;0.1,1e-5;0.2,0` without blanks). Empty lines and text after `#`
     /// are skipped. `name` names the table in errors, with the line.
     pub fn parse(text: &str, name: &str) -> Result<Table> {
+        if !text.contains('\n') && text.contains('#') {
+            return Err(Error::Table(format!(
+                "{name}: a `#` in a table on one line would make the rest of the line, \
+                 points and all, a comment: take the comment out, or give the table a \
+                 line a point"
+            )));
+        }
         let (mut x, mut y) = (Vec::new(), Vec::new());
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or("");
-            for point in line.split(';') {
+            for (k, point) in line.split(';').enumerate() {
                 let fields: Vec<&str> = point
                     .split(|c: char| c.is_whitespace() || c == ',')
                     .filter(|f| !f.is_empty())
@@ -67,9 +74,9 @@ impl Table {
                             x.push(a);
                             y.push(b);
                         }
-                        _ => return Err(Self::bad_line(name, n, point)),
+                        _ => return Err(Self::bad_line(name, n, k, point)),
                     },
-                    _ => return Err(Self::bad_line(name, n, point)),
+                    _ => return Err(Self::bad_line(name, n, k, point)),
                 }
                 if x.len() > MAX_TABLE_POINTS {
                     return Err(out_of_range(
@@ -83,12 +90,18 @@ impl Table {
         Table::new(x, y, name)
     }
 
-    fn bad_line(name: &str, n: usize, point: &str) -> Error {
+    /// Point `k` (from 0) of line `n` (from 0) is not two numbers.
+    fn bad_line(name: &str, n: usize, k: usize, point: &str) -> Error {
+        let part = if k > 0 {
+            format!(", its point {} after a `;`", k + 1)
+        } else {
+            String::new()
+        };
         Error::Table(format!(
-            "{name}: line {}: `{}` is not two numbers (x y, separated by blanks or a comma; \
-             a `;` or a line break between points)",
+            "{name}: line {}{part}: `{}` is not two numbers (x y, separated by blanks or a \
+             comma; a `;` or a line break between points)",
             n + 1,
-            point.trim().chars().take(80).collect::<String>()
+            point.trim().chars().take(40).collect::<String>()
         ))
     }
 

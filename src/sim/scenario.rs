@@ -127,17 +127,23 @@ pub struct VoidedSleepers {
     pub position: f64,
     /// How many, from the first in the direction of travel (1 to 100).
     pub sleepers: usize,
-    /// The gap under each (m, 0 to 0.05).
+    /// The gap under each (m, 0 to [`crate::track::MAX_VOID_GAP`]; 0: resting on the
+    /// ballast, which does not hold it down).
     pub gap: f64,
 }
 
 impl VoidedSleepers {
     /// The gap under each sleeper of a track whose node 0 lies at `origin` (m, line
-    /// coordinates) with `ns` sleepers `spacing` (m) apart.
+    /// coordinates) with `ns` sleepers `spacing` (m) apart: `None` on the ballast.
     ///
     /// Errors: `sleepers` outside 1 to 100 (`track.void.sleepers`), `position` not
     /// finite (`track.void.position`), `gap` outside 0 to 0.05 m (`track.void.gap`).
-    pub fn gaps(&self, origin: f64, ns: usize, spacing: f64) -> crate::error::Result<Vec<f64>> {
+    pub fn gaps(
+        &self,
+        origin: f64,
+        ns: usize,
+        spacing: f64,
+    ) -> crate::error::Result<Vec<Option<f64>>> {
         if !(1..=100).contains(&self.sleepers) {
             return Err(crate::error::out_of_range(
                 "track.void.sleepers",
@@ -146,11 +152,12 @@ impl VoidedSleepers {
             ));
         }
         crate::error::finite("track.void.position", self.position, "m")?;
-        if !(0.0..=0.05).contains(&self.gap) {
+        let max = crate::track::MAX_VOID_GAP;
+        if !(0.0..=max).contains(&self.gap) {
             return Err(crate::error::out_of_range(
                 "track.void.gap",
                 self.gap,
-                "0 m <= track.void.gap <= 0.05 m",
+                format!("0 m <= track.void.gap <= {max} m"),
             ));
         }
         // Sleepers lie at whole multiples of the spacing in line coordinates.
@@ -159,11 +166,7 @@ impl VoidedSleepers {
         Ok((0..ns)
             .map(|i| {
                 let k = node0 + i as i64 - first;
-                if (0..self.sleepers as i64).contains(&k) {
-                    self.gap
-                } else {
-                    0.0
-                }
+                (0..self.sleepers as i64).contains(&k).then_some(self.gap)
             })
             .collect())
     }

@@ -70,14 +70,21 @@ impl Site {
         &self.min
     }
 
+    /// Whether `x` (m, line coordinates) lies inside `track`, whose node 0 lies at
+    /// `origin` (m).
+    fn on_track(track: &Track, origin: f64, x: f64) -> bool {
+        let x = x - origin;
+        x > 0.0 && x < track.params().length()
+    }
+
     /// What `track`, whose node 0 lies at `origin` (m), feels at `x` (m, line
     /// coordinates) now; zeros (the track at rest) outside the track: an endless
     /// track's window has not reached the site yet, or has left it behind.
     fn read(track: &Track, origin: f64, x: f64) -> SiteValues {
-        let x = x - origin;
-        if !(x > 0.0 && x < track.params().length()) {
+        if !Self::on_track(track, origin, x) {
             return [[0.0; NQ]; 2];
         }
+        let x = x - origin;
         [0, 1].map(|rail| {
             let r = track.rail_response(rail, x);
             let s = track.support_response(rail, x);
@@ -96,8 +103,18 @@ impl Site {
         })
     }
 
-    /// The accelerations of [`MOVING`] in `now` from the history, step `dt` (s).
-    fn accelerate(&mut self, dt: f64) {
+    /// The accelerations of [`MOVING`] in `now` from the history, step `dt` (s). Off
+    /// an endless track's window the site reads the track at rest: no acceleration,
+    /// and a history at rest, as the track that enters the window is.
+    fn accelerate(&mut self, dt: f64, on_track: bool) {
+        if !on_track {
+            self.before = [[[0.0; 2]; 2]; 2];
+            for rail in 0..2 {
+                self.now[rail][NQ - 2] = 0.0;
+                self.now[rail][NQ - 1] = 0.0;
+            }
+            return;
+        }
         let k = 1.0 / (dt * dt);
         for rail in 0..2 {
             for (m, &q) in MOVING.iter().enumerate() {
@@ -115,7 +132,7 @@ impl Site {
             }
         }
         self.now = Self::read(track, origin, self.position);
-        self.accelerate(track.dt());
+        self.accelerate(track.dt(), Self::on_track(track, origin, self.position));
         for rail in 0..2 {
             for q in 0..NQ {
                 let x = self.now[rail][q];
@@ -154,7 +171,7 @@ impl Site {
             *slot = x;
         }
         self.now = Self::read(track, origin, self.position);
-        self.accelerate(track.dt());
+        self.accelerate(track.dt(), Self::on_track(track, origin, self.position));
     }
 }
 

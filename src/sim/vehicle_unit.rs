@@ -749,7 +749,10 @@ impl VehicleUnit {
                 "a speed in its range, a finite rotation, a time of change >= 0 s",
             ));
         }
-        for &f in &v[6..head] {
+        // The held forces and their extremes (the accelerations after them are checked
+        // where they are read).
+        let forces_end = 6 + self.wheelsets() * (2 + ForceExtremes::LEN);
+        for &f in &v[6..forces_end] {
             if !within(f, 1e7) {
                 return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
             }

@@ -17,7 +17,7 @@ pub const MAX_RAIL_IRREGULARITY: f64 = 0.01;
 pub struct RailDefect {
     /// Centre along the line (m).
     pub position: f64,
-    /// Length (m), 0.05 to 10.
+    /// Length (m), 0.1 to 10.
     pub length: f64,
     /// Depth (m, positive down), 0 to [`MAX_RAIL_IRREGULARITY`].
     pub depth: f64,
@@ -27,11 +27,12 @@ impl RailDefect {
     /// Checks the fields; `name` prefixes their names (`rail.defect`).
     pub fn validate(&self, name: &str) -> Result<()> {
         crate::error::finite(&format!("{name}.position"), self.position, "m")?;
-        if !(0.05..=10.0).contains(&self.length) {
+        if !(0.1..=10.0).contains(&self.length) {
             return Err(out_of_range(
                 &format!("{name}.length"),
                 self.length,
-                "0.05 m <= length <= 10 m",
+                "0.1 m <= length <= 10 m (the contact sees the rail at the wheel's point: \
+                 shorter defects are the patch's business)",
             ));
         }
         if !(0.0..=MAX_RAIL_IRREGULARITY).contains(&self.depth) {

@@ -38,7 +38,7 @@ pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
 pub use stepper::{PointLoad, Track};
-pub use supports::{SupportLaw, Supports};
+pub use supports::{MAX_VOID_GAP, SupportLaw, Supports};
 
 // What the files of the track share (each begins with `use super::*`).
 use crate::error::{Error, Result, out_of_range, positive};

@@ -24,36 +24,61 @@ pub enum SupportLaw {
 }
 
 /// The supports' law and preloads.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Supports {
     /// Linear or tensionless.
     pub law: SupportLaw,
-    /// Tension a rail pad carries before the rail lifts off it (N per rail seat, 0
-    /// or more): the fastening's clamping force (toe load) that compresses the pad at
-    /// rest, plus the rail's weight on the seat if it is to count (the model's
-    /// displacements are from the track's rest under its own weight). 0: the pad
-    /// lets go at any tension. Typical clips: 2 x 9 to 12 kN per seat.
+    /// Tension a rail pad carries before the rail lifts off it (N per rail seat, 1 N
+    /// to 1 MN; default 20 kN): the fastening's clamping force (toe load) that
+    /// compresses the pad at rest (typical clips: 2 x 9 to 12 kN per seat), with the
+    /// rail's weight on the seat if it is to count. The track's weight is not in the
+    /// model (its displacements are from its rest under that weight), so the preload is
+    /// what pulls a lifted rail back: a rail held by nothing would float.
     pub pad_preload: f64,
     /// Tension the ballast under a rail seat carries before the seat lifts off it (N,
-    /// 0 or more): the weight it carries at rest (half the sleeper's and a span of rail's,
-    /// 1.7 kN on table 4.4's track). 0: it lets go at any tension.
+    /// 1 N to 1 MN; default 1.7 kN): the weight it carries at rest, half the sleeper's
+    /// and a span of rail's, `(m_s / 2 + m a) g` = 1.73 kN on table 4.4's track.
     pub ballast_preload: f64,
 }
 
+impl Default for Supports {
+    /// Linear supports (the thesis); the preloads a tensionless track would take.
+    fn default() -> Self {
+        Supports {
+            law: SupportLaw::Linear,
+            pad_preload: 20e3,
+            ballast_preload: 1.7e3,
+        }
+    }
+}
+
 impl Supports {
-    /// Checks both preloads (finite, >= 0, at most 1 MN).
+    /// Checks both preloads (1 N to 1 MN: a support that lets go at no tension at all
+    /// leaves a weightless rail or sleeper free once it has).
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("track.pad.preload", self.pad_preload),
             ("track.ballast.preload", self.ballast_preload),
         ] {
-            if !(0.0..=1e6).contains(&v) {
-                return Err(out_of_range(name, v, "0 N <= value <= 1e6 N"));
+            if !(1.0..=1e6).contains(&v) {
+                return Err(out_of_range(
+                    name,
+                    v,
+                    "1 N <= value <= 1e6 N (the track's weight is not in the model: the \
+                     preloads hold a lifted rail or sleeper down)",
+                ));
             }
         }
         Ok(())
     }
 }
+
+/// The largest gap under a hanging sleeper (m): voids in service are a few
+/// millimetres.
+pub const MAX_VOID_GAP: f64 = 0.01;
+
+/// The most passes of the static start's active-set iteration.
+const MAX_PASSES: usize = 200;
 
 /// The lift time of a support that carries.
 pub(super) const CARRIES: f64 = -1.0;
@@ -63,8 +88,10 @@ pub(super) const CARRIES: f64 = -1.0;
 #[derive(Debug, Clone)]
 pub(super) struct Unilateral {
     /// Gap between each sleeper and the ballast at rest (m), per sleeper; 0 on the
-    /// ballast.
+    /// ballast (or hanging with no gap: see `hanging`).
     pub(super) gap: Vec<f64>,
+    /// Whether each sleeper hangs (its ballast never pulls, whatever its gap).
+    pub(super) hanging: Vec<bool>,
     /// Tension a pad carries before it lets go (N); infinite with linear supports.
     pub(super) pad_limit: f64,
     /// Tension the ballast under each sleeper's seats carries before it lets go (N):
@@ -96,6 +123,7 @@ impl Unilateral {
     pub(super) fn new(p: &TrackParams, ns: usize, dt: f64) -> Self {
         let mut u = Unilateral {
             gap: vec![0.0; ns],
+            hanging: vec![false; ns],
             pad_limit: f64::INFINITY,
             ballast_limit: vec![f64::INFINITY; ns],
             pad_lifted: vec![CARRIES; 2 * ns],
@@ -131,8 +159,8 @@ impl Unilateral {
         } else {
             f64::INFINITY
         };
-        for (lim, &g) in self.ballast_limit.iter_mut().zip(&self.gap) {
-            *lim = if g > 0.0 {
+        for (lim, &h) in self.ballast_limit.iter_mut().zip(&self.hanging) {
+            *lim = if h {
                 0.0
             } else if tensionless {
                 p.supports.ballast_preload
@@ -303,16 +331,17 @@ pub(super) fn sleepers_unilateral<const FMA: bool>(
 }
 
 impl Track {
-    /// Gaps between the sleepers and the ballast at rest (m, >= 0), one per sleeper
-    /// (`gaps.len()` = [`TrackParams::spans`] + 1): a sleeper with a gap hangs from the
-    /// rails (a voided sleeper) until it has moved down by its gap, and its ballast
-    /// never pulls. From this call on the track steps through the loop of supports
+    /// The hanging (voided) sleepers: per sleeper (`gaps.len()` =
+    /// [`TrackParams::spans`] + 1) `None` on the ballast, or `Some(g)`, the gap (m, 0 or
+    /// more) between it and the ballast at rest: it hangs from the rails until it has
+    /// moved down by its gap, and its ballast never pulls (with `g = 0` it rests on
+    /// the ballast without being held down). From this call on the track steps through the loop of supports
     /// that can lift, which gives the linear loop's numbers bit for bit where no
     /// support can lift (all zeros with linear supports: the thesis' track).
     ///
     /// Errors: a gap below 0, above 0.05 m or not finite (named `track.void.gap`), or
     /// the wrong count.
-    pub fn set_sleeper_gaps(&mut self, gaps: &[f64]) -> Result<()> {
+    pub fn set_sleeper_gaps(&mut self, gaps: &[Option<f64>]) -> Result<()> {
         if gaps.len() != self.ns {
             return Err(out_of_range(
                 "sleeper gaps",
@@ -320,16 +349,23 @@ impl Track {
                 format!("one per sleeper: {}", self.ns),
             ));
         }
-        for &g in gaps {
-            if !(0.0..=0.05).contains(&g) {
-                return Err(out_of_range("track.void.gap", g, "0 m <= gap <= 0.05 m"));
+        for &g in gaps.iter().flatten() {
+            if !(0.0..=MAX_VOID_GAP).contains(&g) {
+                return Err(out_of_range(
+                    "track.void.gap",
+                    g,
+                    format!("0 m <= gap <= {MAX_VOID_GAP} m"),
+                ));
             }
         }
         let (p, ns, dt) = (self.params, self.ns, self.dt);
         let u = self
             .unilateral
             .get_or_insert_with(|| Box::new(Unilateral::new(&p, ns, dt)));
-        u.gap.copy_from_slice(gaps);
+        for (i, g) in gaps.iter().enumerate() {
+            u.gap[i] = g.unwrap_or(0.0);
+            u.hanging[i] = g.is_some();
+        }
         u.set_limits(&p);
         Ok(())
     }
@@ -374,7 +410,7 @@ impl Track {
     /// The static state of a track whose supports can lift: the active-set iteration
     /// over the direct solve (each pass solves with the supports that carried in the
     /// last, the others at their limit; the pads are settled before the ballast; a
-    /// pass that changes none ends it). At most 50 passes.
+    /// pass that changes none ends it). At most [`MAX_PASSES`] passes.
     pub(super) fn set_static_unilateral(&mut self, f: &[f64]) -> Result<()> {
         let (nk, ns) = (self.nk, self.ns);
         let u = self.unilateral.as_ref().expect("supports that can lift");
@@ -387,11 +423,13 @@ impl Track {
         let (izs, iph) = (4 * nk, 4 * nk + ns);
         let n = self.params.nodes_per_span;
         let mut pad_on = vec![true; 2 * ns];
-        let mut ballast_on = vec![true; 2 * ns];
+        // A hanging sleeper starts hanging (its ballast, pulled down to it by the gap,
+        // would pull the sleeper and its pads with it).
+        let mut ballast_on: Vec<bool> = (0..2 * ns).map(|k| !u.hanging[k % ns]).collect();
         // A support lets go beyond its limit by more than this (N): one that sits at
         // it (a hanging sleeper's pads with no preload) keeps carrying.
         let tol = 1e-6;
-        for _ in 0..50 {
+        for _ in 0..MAX_PASSES {
             let mut rhs = f.to_vec();
             for i in 0..ns {
                 let node = i * n;
@@ -478,10 +516,11 @@ impl Track {
                 return Ok(());
             }
         }
-        Err(Error::Unsupported(
+        Err(Error::Unsupported(format!(
             "the static state of the track's lifting supports: the active-set \
-             iteration did not settle in 50 passes"
-                .into(),
-        ))
+                 iteration did not settle in {MAX_PASSES} passes (give the pads and the \
+                 ballast their physical preloads, track.pad.preload and \
+                 track.ballast.preload)"
+        )))
     }
 }

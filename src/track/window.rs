@@ -74,6 +74,9 @@ impl Track {
                 }
             }
             shift_left(&mut u.gap, m);
+            let ns = u.hanging.len();
+            u.hanging.copy_within(m.min(ns).., 0);
+            u.hanging[ns - m.min(ns)..].fill(false);
             u.longest_at -= m as i64;
         }
         // The window's ends are fixed.

@@ -47,28 +47,41 @@ impl OutOfRoundness {
                 format!("-{MAX_RADIUS_DEVIATION} m <= deviation <= {MAX_RADIUS_DEVIATION} m"),
             ));
         }
-        // Once round the wheel: the first point again a turn later.
-        let (b, r) = table.points();
-        let mut angles = b.to_vec();
-        let mut values = r.to_vec();
-        angles.insert(0, b[b.len() - 1] - TAU);
-        values.insert(0, r[r.len() - 1]);
-        angles.push(b[0] + TAU);
-        values.push(r[0]);
-        Ok(OutOfRoundness {
-            table: Table::new(angles, values, name)?,
-        })
+        Ok(OutOfRoundness { table })
+    }
+
+    /// The wrap-around segment, from the last point to the first a turn later: its
+    /// start angle, the deviation there, and its slope; `beta` in `[0, 2 pi)`.
+    #[inline]
+    fn wrap(&self) -> (f64, f64, f64) {
+        let (b, r) = self.table.points();
+        let (b0, r0, b1, r1) = (b[b.len() - 1], r[r.len() - 1], b[0] + TAU, r[0]);
+        (b0, r0, (r1 - r0) / (b1 - b0))
     }
 
     /// The radius deviation (m) at wheel angle `beta` (rad, any; taken round the wheel).
     #[inline]
     pub fn at(&self, beta: f64) -> f64 {
-        self.table.at(beta.rem_euclid(TAU))
+        let beta = beta.rem_euclid(TAU);
+        let (first, last) = self.table.range();
+        if beta >= first && beta <= last {
+            return self.table.at(beta);
+        }
+        // Between the last point and the first, a turn on.
+        let (b0, r0, slope) = self.wrap();
+        let beta = if beta < first { beta + TAU } else { beta };
+        r0 + slope * (beta - b0)
     }
 
     /// `dr/dbeta` (m/rad) at wheel angle `beta` (rad).
     #[inline]
     pub fn slope_at(&self, beta: f64) -> f64 {
-        self.table.slope_at(beta.rem_euclid(TAU))
+        let beta = beta.rem_euclid(TAU);
+        let (first, last) = self.table.range();
+        if beta >= first && beta <= last {
+            self.table.slope_at(beta)
+        } else {
+            self.wrap().2
+        }
     }
 }

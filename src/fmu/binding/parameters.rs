@@ -243,6 +243,10 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
     }
 }
 
+/// The largest table file read (bytes): a million points of two numbers in full
+/// precision with comments to spare.
+pub const MAX_TABLE_FILE: u64 = 100_000_000;
+
 /// The table a String parameter `name` names in `text`: none for an empty text, the
 /// text itself when it holds a `;` or a line break (`0 0; 0.1 2e-5; ...`), else the
 /// file at that path (absolute, or relative to the working directory of the process
@@ -257,12 +261,28 @@ pub fn read_table(name: &str, text: &str) -> Result<Option<Table>, Error> {
     if text.contains(';') || text.contains('\n') {
         return Table::parse(text, name).map(Some);
     }
-    let content = std::fs::read_to_string(text).map_err(|e| {
+    let refuse = |why: String| {
         Error::Table(format!(
-            "{name} = {text:?}: cannot read the table's file ({e}); give a path (absolute, \
-             or relative to the working directory) or the table itself (`x y; x y; ...`)"
+            "{name} = {text:?}: {why}; give a path (absolute, or relative to the working \
+             directory) or the table itself (`x y; x y; ...`)"
         ))
-    })?;
+    };
+    // A regular file of at most MAX_TABLE_FILE bytes: not a directory, a device or a
+    // pipe, which could block or never end.
+    let meta = std::fs::metadata(text)
+        .map_err(|e| refuse(format!("cannot read the table's file ({e})")))?;
+    if !meta.is_file() {
+        return Err(refuse("not a regular file".into()));
+    }
+    if meta.len() > MAX_TABLE_FILE {
+        return Err(refuse(format!(
+            "the file has {} bytes; a table's file holds at most {MAX_TABLE_FILE} (1,000,000 \
+             points)",
+            meta.len()
+        )));
+    }
+    let content = std::fs::read_to_string(text)
+        .map_err(|e| refuse(format!("cannot read the table's file ({e})")))?;
     Table::parse(&content, &format!("{name} ({text})")).map(Some)
 }
 
