@@ -123,3 +123,70 @@ fn a_wheelset_closes_the_gap_under_hanging_sleepers_on_the_endless_track() {
     assert!(sag < intact_sag - 2e-4, "{sag} against {intact_sag}");
     assert!(swing > intact_swing, "{swing} against {intact_swing}");
 }
+
+#[test]
+fn a_site_the_endless_window_leaves_behind_keeps_its_accelerations() {
+    // A site at 10.275 m and a window that keeps 4 m behind the wheel: the site leaves
+    // the window after 0.7 s. Its reading then drops to the track at rest; that drop is
+    // no acceleration (it read -10,150 m/s^2 at the sleeper seat and 2.7e5 m/s^2 at
+    // the rail). What remains is what the passing wheel (and the window's end, 4 m
+    // behind it) caused: 521 and -423 m/s^2 at the rail, against 299 and -138 m/s^2
+    // with a window that keeps the site (100 m behind).
+    let run = |behind: f64| {
+        let mut s = Scenario::table_4_4();
+        s.window = Some(TrackWindow {
+            ahead: 20.0,
+            behind,
+        });
+        s.speed = 70.0 / 3.6;
+        s.sites = vec![10.275];
+        let mut sim = Simulation::new(&s).unwrap();
+        sim.run(3.0, |_| {}).unwrap();
+        let site = &sim.sites()[0];
+        [8, 9].map(|q| (site.max()[0][q], site.min()[0][q]))
+    };
+    for (behind, bound) in [(4.0, 1000.0), (100.0, 500.0)] {
+        for (max, min) in run(behind) {
+            assert!(
+                max < bound && min > -bound,
+                "behind {behind} m: {max} {min}"
+            );
+        }
+    }
+}
+
+#[test]
+fn hanging_sleepers_under_tensionless_supports_start_at_rest_on_any_window() {
+    // A sleeper hanging 1.1 mm under tensionless pads (20 kN clips) and ballast
+    // (1.7 kN): the static start settles (it refused this once, releasing the pads
+    // before the hanging ballast), and with the physical preloads the rail far ahead
+    // of the wheel rests where the linear track's does, whatever the window's length.
+    let mut s = Scenario::table_4_4();
+    s.set_supports(Supports {
+        law: SupportLaw::Tensionless,
+        ..Supports::default()
+    });
+    s.voids = Some(VoidedSleepers {
+        position: 10.0,
+        sleepers: 1,
+        gap: 1.1e-3,
+    });
+    assert!(Simulation::new(&s).is_ok());
+    s.voids = None;
+    s.sites = vec![13.015];
+    let rest = |ahead: f64| {
+        let mut s = s.clone();
+        s.window = Some(TrackWindow {
+            ahead,
+            behind: 20.0,
+        });
+        Simulation::new(&s).unwrap().sites()[0].now()[0][0]
+    };
+    for ahead in [20.0, 40.0, 100.0] {
+        let z = rest(ahead);
+        assert!(
+            z.abs() < 2e-5,
+            "window ahead {ahead} m: the rail at 13 m rests at {z} m"
+        );
+    }
+}

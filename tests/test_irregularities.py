@@ -81,18 +81,38 @@ def test_the_dipped_weld_is_the_same_dip_as_a_table(coupled):
 
 
 @pytest.mark.parametrize("name, value, message", [
-    ("rail.left.profile", "0 0; 8 x", "rail.left.profile: line 1: `8 x` is not two numbers"),
+    ("rail.left.profile", "0 0; 8 x", "rail.left.profile: line 1, its point 2 after a `;`: `8 x` is not two numbers"),
+    ("rail.left.profile", "0,0;8,0;8.5,-2e-3#dip;9,0;30,0", "a `#` in a table on one line"),
     ("rail.left.profile", "/no/such/table.txt", 'rail.left.profile = "/no/such/table.txt": cannot read'),
     ("rail.right.profile", "0 0; 1 0.02", "rail.right.profile (height)"),
     ("rail.left.profile", "0 0; 0 1e-4", "point 2"),
     ("wheel.left.out_of_roundness", "0 0; 7 1e-4", "wheel.left.out_of_roundness (wheel angle)"),
     ("wheel.right.out_of_roundness", "0 0; 1 0.01", "wheel.right.out_of_roundness (radius deviation)"),
+    ("rail.left.profile", "/tmp", 'rail.left.profile = "/tmp": not a regular file'),
 ])
 def test_a_bad_table_is_refused_when_it_is_set_with_its_name(coupled, capfd, name, value, message):
     with pytest.raises(FMICallException):
         simulate_fmu(coupled, stop_time=0.01, start_values={name: value})
     out = capfd.readouterr().out
     assert "fmi2SetString" in out and message in out, out
+
+
+def test_a_pipe_is_refused_without_waiting_for_it(coupled, capfd, tmp_path):
+    # A named pipe (or a device such as /dev/zero) would block or never end.
+    fifo = tmp_path / "table.fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(FMICallException):
+        simulate_fmu(coupled, stop_time=0.01, start_values={"rail.left.profile": str(fifo)})
+    assert "not a regular file" in capfd.readouterr().out
+    with pytest.raises(FMICallException):
+        simulate_fmu(coupled, stop_time=0.01, start_values={"rail.left.profile": "/dev/zero"})
+    assert "not a regular file" in capfd.readouterr().out
+
+
+def test_a_dipped_weld_shorter_than_the_patch_allows_is_refused(coupled, capfd):
+    with pytest.raises(FMICallException):
+        simulate_fmu(coupled, stop_time=0.01, start_values={"rail.defect.length": 0.05})
+    assert "`rail.defect.length` = 0.05 m is out of range" in capfd.readouterr().out
 
 
 def test_an_fmu_state_carries_the_tables_into_a_fresh_instance(coupled):

@@ -252,3 +252,28 @@ fn the_state_of_lifting_supports_restores_bit_for_bit_and_moves_with_the_window(
     assert_eq!(a.lift_times(0, 9), before.0);
     assert_eq!(a.longest_lift().1, before.1.1 - 3);
 }
+
+#[test]
+fn a_sleeper_hanging_with_no_gap_rests_on_ballast_that_never_pulls() {
+    // Gap 0: the sleeper touches the ballast at rest, which carries it as before while
+    // pressed and lets go instead of pulling: the run is the linear track's until the
+    // ballast under it would pull, and its seat forces never go below 0 after.
+    let loads = wheelset(10.0 * 0.685 + 0.2, 150e3);
+    let mut linear = track(20, Supports::default());
+    let mut hanging = track(20, Supports::default());
+    let mut gaps = vec![None; 21];
+    gaps[12] = Some(0.0);
+    hanging.set_sleeper_gaps(&gaps).unwrap();
+    let mut lifted = false;
+    for _ in 0..4000 {
+        linear.step(&loads);
+        hanging.step(&loads);
+        for rail in 0..2 {
+            let b = hanging.support_response(rail, 12.0 * 0.685).ballast_force;
+            assert!(b >= 0.0, "{b}");
+            lifted |= hanging.lift_times(rail, 12).1 > 0.0;
+        }
+    }
+    assert!(lifted, "the ballast under it lets go");
+    assert_ne!(linear.sleeper_z(), hanging.sleeper_z());
+}

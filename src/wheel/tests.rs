@@ -175,3 +175,21 @@ fn wrap_is_into_half_open_interval() {
     assert!((wrap_angle(-PI) - PI).abs() < 1e-12);
     assert!((wrap_angle(0.1 - 4.0 * PI) - 0.1).abs() < 1e-12);
 }
+
+#[test]
+fn an_out_of_roundness_takes_a_million_points_and_joins_its_ends_round_the_wheel() {
+    use crate::numerics::{MAX_TABLE_POINTS, Table};
+    use crate::wheel::OutOfRoundness;
+    use std::f64::consts::TAU;
+    let n = MAX_TABLE_POINTS;
+    let b: Vec<f64> = (0..n).map(|i| 0.001 + 6.28 * i as f64 / n as f64).collect();
+    let r: Vec<f64> = b.iter().map(|b| 1e-4 * b.sin()).collect();
+    let w = OutOfRoundness::new(Table::new(b.clone(), r.clone(), "w").unwrap(), "w").unwrap();
+    // Between the last point and the first a turn on: the straight line.
+    let (b0, r0, b1, r1) = (b[n - 1], r[n - 1], b[0] + TAU, r[0]);
+    let mid = 0.5 * (b0 + b1);
+    assert!((w.at(mid) - 0.5 * (r0 + r1)).abs() < 1e-18);
+    assert!((w.at(mid - TAU) - w.at(mid)).abs() < 1e-18);
+    assert!((w.slope_at(mid) - (r1 - r0) / (b1 - b0)).abs() < 1e-12);
+    assert!((w.at(b[7] + 3.0 * TAU) - r[7]).abs() < 1e-15);
+}
