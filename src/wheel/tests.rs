@@ -182,7 +182,7 @@ fn an_out_of_roundness_takes_a_million_points_and_joins_its_ends_round_the_wheel
     use crate::wheel::OutOfRoundness;
     use std::f64::consts::TAU;
     let n = MAX_TABLE_POINTS;
-    let b: Vec<f64> = (0..n).map(|i| 0.001 + 6.28 * i as f64 / n as f64).collect();
+    let b: Vec<f64> = (0..n).map(|i| 0.001 + 6.2 * i as f64 / n as f64).collect();
     let r: Vec<f64> = b.iter().map(|b| 1e-4 * b.sin()).collect();
     let w = OutOfRoundness::new(Table::new(b.clone(), r.clone(), "w").unwrap(), "w").unwrap();
     // Between the last point and the first a turn on: the straight line.
