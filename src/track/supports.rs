@@ -92,6 +92,13 @@ pub(super) struct Unilateral {
     pub(super) gap: Vec<f64>,
     /// Whether each sleeper hangs (its ballast never pulls, whatever its gap).
     pub(super) hanging: Vec<bool>,
+    /// The sleepers whose supports can lift (a pad or ballast seat with a finite
+    /// limit), in order: the others are the linear track's.
+    candidates: Vec<usize>,
+    /// The candidates' bounce and roll a step back, saved before the vectorised loop
+    /// writes a step on over them (m, rad), in the order of `candidates`.
+    zp: Vec<f64>,
+    fp: Vec<f64>,
     /// Tension a pad carries before it lets go (N); infinite with linear supports.
     pub(super) pad_limit: f64,
     /// Tension the ballast under each sleeper's seats carries before it lets go (N):
@@ -124,6 +131,9 @@ impl Unilateral {
         let mut u = Unilateral {
             gap: vec![0.0; ns],
             hanging: vec![false; ns],
+            candidates: Vec::new(),
+            zp: Vec::new(),
+            fp: Vec::new(),
             pad_limit: f64::INFINITY,
             ballast_limit: vec![f64::INFINITY; ns],
             pad_lifted: vec![CARRIES; 2 * ns],
@@ -168,6 +178,11 @@ impl Unilateral {
                 f64::INFINITY
             };
         }
+        self.candidates = (0..self.gap.len())
+            .filter(|&i| tensionless || self.hanging[i])
+            .collect();
+        self.zp = vec![0.0; self.candidates.len()];
+        self.fp = vec![0.0; self.candidates.len()];
     }
 
     /// Takes one step of lift (or contact) of a support into its time and the longest.
@@ -252,12 +267,12 @@ impl Unilateral {
     }
 }
 
-/// [`sleepers_body`] with supports that can lift: the pad forces (3.9) clamped at the
-/// pad's limit, then each sleeper's update (3.18) with the seats whose ballast carries
-/// (the same expressions, bit for bit, for a sleeper whose seats both carry and that
-/// has no gap), the others at their limit; the seats that carry are found by at most
-/// three passes (two seats: the passes settle at once but for a seat at its limit to
-/// rounding). Also counts each support's lift.
+/// [`sleepers_body`] with supports that can lift: the vectorised loop for every
+/// sleeper as if all its supports carried, then a scan for the sleepers where that is
+/// not so (a pad beyond its limit, a ballast seat beyond its limit with the new
+/// positions, a hanging sleeper with a gap), which are done again by
+/// [`sleeper_with_limits`] from their saved state a step back. Elsewhere the numbers
+/// are the linear loop's, bit for bit. Also counts each support's lift.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(super) fn sleepers_unilateral<const FMA: bool>(
@@ -275,59 +290,125 @@ pub(super) fn sleepers_unilateral<const FMA: bool>(
     u: &mut Unilateral,
 ) {
     let ns = u.gap.len();
+    // The candidates a step back, which the loop overwrites with a step on.
+    for (k, &i) in u.candidates.iter().enumerate() {
+        u.zp[k] = zsp[i];
+        u.fp[k] = php[i];
+    }
+    sleepers_body::<FMA>(rl, rr, rlp, rrp, zs, ph, zsp, php, pl, pr, c);
     let dt = u.dt;
+    let pad_lim = u.pad_limit;
     let mut longest = (u.longest, u.longest_at);
-    for i in 0..ns {
-        let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
-        let (ul, ur) = (
-            rl[i] - madd::<FMA>(-c.ls, f, z),
-            rr[i] - madd::<FMA>(c.ls, f, z),
-        );
-        let (upl, upr) = (
-            rlp[i] - madd::<FMA>(-c.ls, fp, zp),
-            rrp[i] - madd::<FMA>(c.ls, fp, zp),
-        );
-        let mut fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
-        let mut fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
-        let lim = u.pad_limit;
-        let (lifted_l, lifted_r) = (fl < -lim, fr < -lim);
-        if lifted_l {
-            fl = -lim;
-        }
-        if lifted_r {
-            fr = -lim;
-        }
-        Unilateral::lift(&mut u.pad_lifted[i], lifted_l, dt, &mut longest, i);
-        Unilateral::lift(&mut u.pad_lifted[ns + i], lifted_r, dt, &mut longest, i);
-        pl[i] = fl;
-        pr[i] = fr;
+    for k in 0..u.candidates.len() {
+        let i = u.candidates[k];
         let (g, lim) = (u.gap[i], u.ballast_limit[i]);
-        let mut on = [true, true];
-        let (mut zn, mut pn) = if g == 0.0 {
-            (
-                madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z)),
-                madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f)),
-            )
-        } else {
-            u.solve(z, f, zp, fp, fl, fr, g, lim, on)
+        let pads_carry = pl[i] >= -pad_lim && pr[i] >= -pad_lim;
+        let fast = pads_carry && g == 0.0 && {
+            let (z, f, zp, fp) = (zs[i], ph[i], u.zp[k], u.fp[k]);
+            let force = u.ballast_forces(z, f, zp, fp, zsp[i], php[i], 0.0);
+            force[0] >= -lim && force[1] >= -lim
         };
-        if lim.is_finite() {
-            for _ in 0..3 {
-                let force = u.ballast_forces(z, f, zp, fp, zn, pn, g);
-                let carries = force.map(|x| x >= -lim);
-                if carries == on {
-                    break;
-                }
-                on = carries;
-                (zn, pn) = u.solve(z, f, zp, fp, fl, fr, g, lim, on);
+        if fast {
+            for a in [&mut u.pad_lifted, &mut u.ballast_lifted] {
+                a[i] = CARRIES;
+                a[ns + i] = CARRIES;
             }
+            continue;
         }
-        zsp[i] = zn;
-        php[i] = pn;
-        Unilateral::lift(&mut u.ballast_lifted[i], !on[0], dt, &mut longest, i);
-        Unilateral::lift(&mut u.ballast_lifted[ns + i], !on[1], dt, &mut longest, i);
+        let lifted = sleeper_with_limits::<FMA>(
+            [rl[i], rr[i], rlp[i], rrp[i]],
+            [zs[i], ph[i]],
+            [u.zp[k], u.fp[k]],
+            i,
+            zsp,
+            php,
+            pl,
+            pr,
+            c,
+            u,
+        );
+        Unilateral::lift(&mut u.pad_lifted[i], lifted[0], dt, &mut longest, i);
+        Unilateral::lift(&mut u.pad_lifted[ns + i], lifted[1], dt, &mut longest, i);
+        Unilateral::lift(&mut u.ballast_lifted[i], lifted[2], dt, &mut longest, i);
+        Unilateral::lift(
+            &mut u.ballast_lifted[ns + i],
+            lifted[3],
+            dt,
+            &mut longest,
+            i,
+        );
     }
     (u.longest, u.longest_at) = longest;
+}
+
+/// Sleeper `i` of [`sleepers_unilateral`] again with its supports' limits: the rail
+/// over its seats now and a step back `[left, right, left back, right back]` (m), its
+/// bounce and roll now and a step back (m, rad): the pad
+/// forces (3.9) clamped at the pad's limit, then its update (3.18) with the seats
+/// whose ballast carries (found by at most three passes; two seats settle at once but
+/// for a seat at its limit to rounding), the others at their limit. Writes the pad
+/// forces and the sleeper a step on; returns which of `[left pad, right pad, left
+/// ballast, right ballast]` are lifted.
+// Inlined, so that it is compiled for the SIMD level with its fused multiply-adds (out
+// of line, `mul_add` is a library call).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn sleeper_with_limits<const FMA: bool>(
+    rail: [f64; 4],
+    now: [f64; 2],
+    back: [f64; 2],
+    i: usize,
+    zsp: &mut [f64],
+    php: &mut [f64],
+    pl: &mut [f64],
+    pr: &mut [f64],
+    c: &SleeperCoeffs,
+    u: &Unilateral,
+) -> [bool; 4] {
+    let [rl, rr, rlp, rrp] = rail;
+    let [z, f] = now;
+    let [zp, fp] = back;
+    let (ul, ur) = (rl - madd::<FMA>(-c.ls, f, z), rr - madd::<FMA>(c.ls, f, z));
+    let (upl, upr) = (
+        rlp - madd::<FMA>(-c.ls, fp, zp),
+        rrp - madd::<FMA>(c.ls, fp, zp),
+    );
+    let mut fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
+    let mut fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
+    let lim = u.pad_limit;
+    let (lifted_l, lifted_r) = (fl < -lim, fr < -lim);
+    if lifted_l {
+        fl = -lim;
+    }
+    if lifted_r {
+        fr = -lim;
+    }
+    pl[i] = fl;
+    pr[i] = fr;
+    let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+    let mut on = [true, true];
+    let (mut zn, mut pn) = if g == 0.0 {
+        (
+            madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z)),
+            madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f)),
+        )
+    } else {
+        u.solve(z, f, zp, fp, fl, fr, g, lim, on)
+    };
+    if lim.is_finite() {
+        for _ in 0..3 {
+            let force = u.ballast_forces(z, f, zp, fp, zn, pn, g);
+            let carries = force.map(|x| x >= -lim);
+            if carries == on {
+                break;
+            }
+            on = carries;
+            (zn, pn) = u.solve(z, f, zp, fp, fl, fr, g, lim, on);
+        }
+    }
+    zsp[i] = zn;
+    php[i] = pn;
+    [lifted_l, lifted_r, !on[0], !on[1]]
 }
 
 impl Track {

@@ -77,6 +77,8 @@ impl Track {
             let ns = u.hanging.len();
             u.hanging.copy_within(m.min(ns).., 0);
             u.hanging[ns - m.min(ns)..].fill(false);
+            let p = self.params;
+            u.set_limits(&p);
             u.longest_at -= m as i64;
         }
         // The window's ends are fixed.
