@@ -144,10 +144,19 @@ def inline(v):
     return ";" in v or "\n" in v
 
 
+def _is_number(v):
+    try:
+        float(v)
+        return True
+    except ValueError:
+        return False
+
+
 def _path_from(base, v):
-    """A table's path `v` taken from the folder `base` when relative; other values as
+    """A table's path `v` taken from the folder `base` when relative; other values (and
+    text that reads as a number, which is refused later as a String for a number) as
     they are."""
-    if isinstance(v, str) and not inline(v) and not os.path.isabs(v):
+    if isinstance(v, str) and not inline(v) and not os.path.isabs(v) and not _is_number(v):
         return os.path.normpath(os.path.join(base, v))
     return v
 
@@ -225,6 +234,8 @@ def _values(name, entry):
     if not values:
         raise ValueError(f"sweep `{name}`: no values")
     f = UNITS[unit]
+    if unit and any(isinstance(v, str) for v in values):
+        raise ValueError(f"{where}: unit = {unit!r} with text values (tables): a unit is for numbers")
     # + 0.0 makes -0.0 the 0.0 it is (else the same physics ran as two cases).
     return [_text(where, v) if isinstance(v, str) else _number(where, v) * f + 0.0 for v in values], unit
 

@@ -11,7 +11,8 @@ pub const SIGNALS: usize = 4;
 /// extremes since the start. The engine records the sample that drives each step
 /// (its crate-private `record`); the acceleration at the current time `t` is
 /// `(z(t) - 2 z(t - dt) + z(t - 2 dt)) / dt^2`, the central second difference at
-/// `t - dt`, one step (about 10 us) behind: summed twice it gives the displacements
+/// `t - dt`, one step behind (where the step changed, the difference of the two
+/// slopes over the mean step): summed twice it gives the displacements
 /// back exactly. The run starts in the static state: the wheels at rest, as if they
 /// had stood still before it; the rail under a moving wheel is not a material point
 /// (the wheel moves over the grid's nodes and sleepers), so its acceleration starts a
@@ -20,6 +21,10 @@ pub const SIGNALS: usize = 4;
 pub struct Accelerations {
     /// The displacements of the last two recorded samples, the latest first (m).
     z: [[f64; SIGNALS]; 2],
+    /// The step taken after each of them (s): after the latest, the spacing to the
+    /// sample now; after the one before, the spacing to the latest. Equal but where
+    /// the step changed.
+    h: [f64; 2],
     /// Samples recorded, up to 2.
     recorded: u8,
     /// Largest and smallest acceleration of the recorded samples (m/s^2).
@@ -32,57 +37,67 @@ impl Accelerations {
     /// saved before the first step serialises.
     pub const NONE: Accelerations = Accelerations {
         z: [[0.0; SIGNALS]; 2],
+        h: [1.0; 2],
         recorded: 0,
         max: [f64::MIN; SIGNALS],
         min: [f64::MAX; SIGNALS],
     };
 
     /// Values in a state vector.
-    pub(crate) const LEN: usize = 4 * SIGNALS + 1;
+    pub(crate) const LEN: usize = 4 * SIGNALS + 3;
 
-    /// The second difference of `z` over the recorded history, step `dt` (s).
+    /// The second difference of `z`, the displacements now, over the recorded
+    /// history: `(z - 2 z_1 + z_2) / h^2` on equal steps, and where the step changed
+    /// the difference of the two slopes over the mean step, `2 ((z - z_1) / h_1 - (z_1 -
+    /// z_2) / h_2) / (h_1 + h_2)`.
     #[inline(always)]
-    fn second_difference(&self, z: &[f64; SIGNALS], dt: f64) -> [f64; SIGNALS] {
+    fn second_difference(&self, z: &[f64; SIGNALS]) -> [f64; SIGNALS] {
         if self.recorded == 0 {
             return [0.0; SIGNALS];
         }
-        let k = 1.0 / (dt * dt);
         let [a, b] = &self.z;
+        let [h1, h2] = self.h;
+        let uneven = h1 != h2;
+        let k = 1.0 / (h1 * h1);
         std::array::from_fn(|i| {
             if self.recorded == 1 && i >= 2 {
                 // The rail under a wheel before its second sample.
                 0.0
+            } else if uneven {
+                2.0 * ((z[i] - a[i]) / h1 - (a[i] - b[i]) / h2) / (h1 + h2)
             } else {
                 (z[i] - 2.0 * a[i] + b[i]) * k
             }
         })
     }
 
-    /// Takes the displacements `z` (m) of a step's sample in, step `dt` (s): the
-    /// acceleration at the step before joins the extremes.
+    /// Takes the displacements `z` (m) of the sample that drives the step `dt` (s)
+    /// about to be taken: the acceleration at the step before joins the extremes.
     #[inline(always)]
     pub(crate) fn record(&mut self, z: [f64; SIGNALS], dt: f64) {
         if self.recorded == 0 {
             // At rest at the start.
             self.z = [z, z];
+            self.h = [dt, dt];
             self.recorded = 1;
             self.max = [0.0; SIGNALS];
             self.min = [0.0; SIGNALS];
             return;
         }
-        let a = self.second_difference(&z, dt);
+        let a = self.second_difference(&z);
         self.recorded = 2;
         for i in 0..SIGNALS {
             self.max[i] = self.max[i].max(a[i]);
             self.min[i] = self.min[i].min(a[i]);
         }
         self.z = [z, self.z[0]];
+        self.h = [dt, self.h[0]];
     }
 
-    /// The accelerations (m/s^2) when the displacements are `z` (m) now, one step `dt`
-    /// (s) after the latest recorded sample.
-    pub fn now(&self, z: [f64; SIGNALS], dt: f64) -> [f64; SIGNALS] {
-        self.second_difference(&z, dt)
+    /// The accelerations (m/s^2) when the displacements are `z` (m) now, a step after
+    /// the latest recorded sample.
+    pub fn now(&self, z: [f64; SIGNALS]) -> [f64; SIGNALS] {
+        self.second_difference(&z)
     }
 
     /// The largest acceleration of the steps taken (m/s^2; the one `now` before the
@@ -99,11 +114,13 @@ impl Accelerations {
 
     /// `d a / d z` (1/s^2) of signal `i`'s acceleration now against its displacement
     /// now: `1 / dt^2` once its history is there, else 0.
-    pub fn gain(&self, i: usize, dt: f64) -> f64 {
+    pub fn gain(&self, i: usize) -> f64 {
+        let [h1, h2] = self.h;
         match self.recorded {
             0 => 0.0,
             1 if i >= 2 => 0.0,
-            _ => 1.0 / (dt * dt),
+            _ if h1 != h2 => 2.0 / (h1 * (h1 + h2)),
+            _ => 1.0 / (h1 * h1),
         }
     }
 
@@ -115,7 +132,7 @@ impl Accelerations {
             .chain(&self.z[1])
             .chain(&self.max)
             .chain(&self.min);
-        for (slot, &x) in v.iter_mut().zip(parts) {
+        for (slot, &x) in v.iter_mut().zip(parts.chain(&self.h)) {
             *slot = x;
         }
         v[Self::LEN - 1] = self.recorded as f64;
@@ -130,6 +147,7 @@ impl Accelerations {
             z: [part(0), part(1)],
             max: part(2),
             min: part(3),
+            h: [v[4 * SIGNALS], v[4 * SIGNALS + 1]],
             recorded: v[Self::LEN - 1].clamp(0.0, 2.0) as u8,
         }
     }
@@ -150,9 +168,9 @@ mod tests {
             [v, -v, 2.0 * v, 0.0]
         };
         let mut a = Accelerations::NONE;
-        assert_eq!(a.now(z(0), dt), [0.0; 4]);
+        assert_eq!(a.now(z(0)), [0.0; 4]);
         a.record(z(0), dt);
-        let first = a.now(z(1), dt);
+        let first = a.now(z(1));
         assert!((first[0] - (z(1)[0] - z(0)[0]) / (dt * dt)).abs() < 1e-9);
         assert_eq!(
             first[2], 0.0,
@@ -161,7 +179,7 @@ mod tests {
         for j in 1..50 {
             a.record(z(j), dt);
         }
-        let now = a.now(z(50), dt);
+        let now = a.now(z(50));
         assert!(
             (now[0] - 3.0).abs() < 1e-6 && (now[1] + 3.0).abs() < 1e-6,
             "{now:?}"

@@ -1260,7 +1260,12 @@ impl Simulation {
         match &self.track {
             TrackState::Discrete(t) => match t.longest_lift() {
                 (0.0, _) => 0.0,
-                (_, i) => self.origin + i as f64 * t.params().sleeper_spacing,
+                // The sleeper's index along the line times the spacing: the same
+                // number for the same sleeper whatever the window's origin.
+                (_, i) => {
+                    let a = t.params().sleeper_spacing;
+                    ((self.origin / a).round() + i as f64) * a
+                }
             },
             TrackState::Lumped(_) => 0.0,
         }

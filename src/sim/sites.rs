@@ -47,6 +47,9 @@ pub struct Site {
     /// The rail's and the seat's displacements ([`MOVING`]) of each rail at the last
     /// two steps, the latest first (m).
     before: [[[f64; 2]; 2]; 2],
+    /// The steps (s) from the latest of them to now and from the one before to the
+    /// latest: equal but where the step changed.
+    steps: [f64; 2],
     now: SiteValues,
     max: SiteValues,
     min: SiteValues,
@@ -72,6 +75,9 @@ impl Site {
 
     /// Whether `x` (m, line coordinates) lies inside `track`, whose node 0 lies at
     /// `origin` (m).
+    /// Not on the window's end nodes: an endless window holds its ends at rest (the
+    /// rail there jumps to 0 as the window moves on), so a site there reads the track
+    /// at rest already, a span before its sleeper leaves the window.
     fn on_track(track: &Track, origin: f64, x: f64) -> bool {
         let x = x - origin;
         x > 0.0 && x < track.params().length()
@@ -106,7 +112,7 @@ impl Site {
     /// The accelerations of [`MOVING`] in `now` from the history, step `dt` (s). Off
     /// an endless track's window the site reads the track at rest: no acceleration,
     /// and a history at rest, as the track that enters the window is.
-    fn accelerate(&mut self, dt: f64, on_track: bool) {
+    fn accelerate(&mut self, on_track: bool) {
         if !on_track {
             self.before = [[[0.0; 2]; 2]; 2];
             for rail in 0..2 {
@@ -115,11 +121,18 @@ impl Site {
             }
             return;
         }
-        let k = 1.0 / (dt * dt);
+        let [h1, h2] = self.steps;
+        let k = 1.0 / (h1 * h1);
         for rail in 0..2 {
             for (m, &q) in MOVING.iter().enumerate() {
                 let [a, b] = self.before[rail][m];
-                self.now[rail][NQ - 2 + m] = (self.now[rail][q] - 2.0 * a + b) * k;
+                let z = self.now[rail][q];
+                // Where the step changed: the slopes' difference over the mean step.
+                self.now[rail][NQ - 2 + m] = if h1 != h2 {
+                    2.0 * ((z - a) / h1 - (a - b) / h2) / (h1 + h2)
+                } else {
+                    (z - 2.0 * a + b) * k
+                };
             }
         }
     }
@@ -131,8 +144,9 @@ impl Site {
                 self.before[rail][m] = [self.now[rail][q], self.before[rail][m][0]];
             }
         }
+        self.steps = [track.dt(), self.steps[0]];
         self.now = Self::read(track, origin, self.position);
-        self.accelerate(track.dt(), Self::on_track(track, origin, self.position));
+        self.accelerate(Self::on_track(track, origin, self.position));
         for rail in 0..2 {
             for q in 0..NQ {
                 let x = self.now[rail][q];
@@ -145,7 +159,7 @@ impl Site {
     /// Values of the extremes and of the accelerations' history in the order state
     /// vectors store them.
     pub(crate) fn extremes(&self) -> impl Iterator<Item = f64> + '_ {
-        let before = self.before.iter().flatten().flatten();
+        let before = self.before.iter().flatten().flatten().chain(&self.steps);
         self.max
             .iter()
             .chain(&self.min)
@@ -155,12 +169,17 @@ impl Site {
     }
 
     /// Number of values [`Site::extremes`] yields.
-    pub(crate) const STATE_LEN: usize = 4 * NQ + 8;
+    pub(crate) const STATE_LEN: usize = 4 * NQ + 10;
 
     /// Restores the extremes and history from [`Site::extremes`] and reads the track
     /// now.
     pub(crate) fn restore(&mut self, track: &Track, origin: f64, v: &[f64]) {
-        let before = self.before.iter_mut().flatten().flatten();
+        let before = self
+            .before
+            .iter_mut()
+            .flatten()
+            .flatten()
+            .chain(&mut self.steps);
         let slots = self
             .max
             .iter_mut()
@@ -171,7 +190,7 @@ impl Site {
             *slot = x;
         }
         self.now = Self::read(track, origin, self.position);
-        self.accelerate(track.dt(), Self::on_track(track, origin, self.position));
+        self.accelerate(Self::on_track(track, origin, self.position));
     }
 }
 
@@ -217,6 +236,7 @@ pub(crate) fn sites(
             Ok(Site {
                 position: x,
                 before: [at_rest(0), at_rest(1)],
+                steps: [track.dt(); 2],
                 now,
                 max: now,
                 min: now,

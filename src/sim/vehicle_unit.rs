@@ -419,7 +419,7 @@ impl VehicleUnit {
             return [[0.0; 2]; 3];
         };
         let a = &self.accelerations[k.min(1)];
-        let now = a.now([z[0], z[1], 0.0, 0.0], self.clock.dt);
+        let now = a.now([z[0], z[1], 0.0, 0.0]);
         [now, a.max(now), a.min(now)].map(|x| [x[0], x[1]])
     }
 

@@ -136,13 +136,13 @@ impl Wheelset {
         self.extremes.min
     }
     /// The vertical accelerations `[wheel left, wheel right, rail left, rail right]`
-    /// (m/s^2, up) when the sample now is `now` and the step `dt` (s), with their
+    /// (m/s^2, up) when the sample now is `now`, with their
     /// largest and smallest of the steps taken: the second differences of
     /// [`Sample::wheel_z`] and [`Sample::rail_z`] at the engine's steps
     /// ([`Accelerations`]).
-    pub fn accelerations(&self, now: &Sample, dt: f64) -> [[f64; 4]; 3] {
+    pub fn accelerations(&self, now: &Sample) -> [[f64; 4]; 3] {
         let z = [now.wheel_z[0], now.wheel_z[1], now.rail_z[0], now.rail_z[1]];
-        let a = self.accelerations.now(z, dt);
+        let a = self.accelerations.now(z);
         [a, self.accelerations.max(a), self.accelerations.min(a)]
     }
 

@@ -94,7 +94,7 @@ impl FmuModel {
             View::Sim(sim, s) => sim
                 .wheelsets()
                 .get(index)
-                .map_or(0.0, |w| w.accelerations(s, sim.dt())[which][signal]),
+                .map_or(0.0, |w| w.accelerations(s)[which][signal]),
             // The vehicles carry the wheels, not the rail.
             View::Vehicle(u) if signal < 2 => u.wheel_accelerations(index)[which][signal],
             View::Vehicle(_) => f64::NAN,

@@ -1015,7 +1015,7 @@ impl Model for FmuModel {
                     (false, true) => -c * p_gamma(),
                     (false, false) => c * k * s,
                 };
-                w.acceleration_record().gain(signal, sim.dt()) * dz
+                w.acceleration_record().gain(signal) * dz
             }
             _ => 0.0,
         })
