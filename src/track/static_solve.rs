@@ -3,6 +3,10 @@
 
 use super::*;
 
+/// The most passes of the static start's active-set iteration
+/// ([`Track::set_static_unilateral`]).
+const MAX_PASSES: usize = 200;
+
 impl Track {
     /// Number of unknowns of the static problem.
     pub(super) fn static_size(&self) -> usize {
@@ -245,5 +249,122 @@ impl Track {
         let kin = 0.5 * v.component_mul(&v).dot(&mass);
         let pot = 0.5 * xp.dot(&(k * &x));
         kin + pot
+    }
+
+    /// The static state of a track whose supports can lift: the active-set iteration
+    /// over the direct solve (each pass solves with the supports that carried in the
+    /// last, the others at their limit; the pads are settled before the ballast; a
+    /// pass that changes none ends it). At most [`MAX_PASSES`] passes.
+    pub(super) fn set_static_unilateral(&mut self, f: &[f64]) -> Result<()> {
+        let (nk, ns) = (self.nk, self.ns);
+        let u = self.unilateral.as_ref().expect("supports that can lift");
+        let (pad_lim, kp, kb) = (
+            u.pad_limit,
+            self.params.pad_stiffness,
+            self.params.ballast_stiffness,
+        );
+        let ls = 0.5 * self.params.rail_seat_distance;
+        let (izs, iph) = (4 * nk, 4 * nk + ns);
+        let n = self.params.nodes_per_span;
+        let mut pad_on = vec![true; 2 * ns];
+        // A hanging sleeper starts hanging (its ballast, pulled down to it by the gap,
+        // would pull the sleeper and its pads with it).
+        let mut ballast_on: Vec<bool> = (0..2 * ns).map(|k| !u.hanging[k % ns]).collect();
+        // A support lets go beyond its limit by more than this (N): one that sits at
+        // it (a hanging sleeper's pads with no preload) keeps carrying.
+        let tol = 1e-6;
+        for _ in 0..MAX_PASSES {
+            let mut rhs = f.to_vec();
+            for i in 0..ns {
+                let node = i * n;
+                let fixed = node == 0 || node == nk - 1;
+                let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+                for (s, arm) in [(0usize, -ls), (1usize, ls)] {
+                    if !pad_on[s * ns + i] {
+                        if !fixed {
+                            rhs[s * nk + node] -= pad_lim;
+                        }
+                        rhs[izs + i] += pad_lim;
+                        rhs[iph + i] += arm * pad_lim;
+                    }
+                    let load = if ballast_on[s * ns + i] {
+                        -kb * g
+                    } else {
+                        -lim
+                    };
+                    rhs[izs + i] += load;
+                    rhs[iph + i] += arm * load;
+                }
+            }
+            let order = self.static_order_along_track();
+            let on = (pad_on.as_slice(), ballast_on.as_slice());
+            let x = solve_banded_spd(
+                &order,
+                |add| self.stiffness_entries_with(Some(on), add),
+                &rhs,
+            )
+            .ok_or_else(|| {
+                Error::Unsupported(
+                    "the static state of a track whose lifted supports leave a sleeper \
+                         free (no pad or ballast holds it): give the pads a preload \
+                         (track.pad.preload) or the hanging sleepers a smaller gap"
+                        .into(),
+                )
+            })?;
+            // The pads first: a pass that releases or takes back a pad leaves the
+            // ballast as it was (released together, a sleeper's pads and ballast
+            // would leave it free, where its ballast carries nothing once the pads
+            // have let go).
+            let mut pads = pad_on.clone();
+            let mut seats = ballast_on.clone();
+            for i in 0..ns {
+                let node = i * n;
+                let (g, lim) = (u.gap[i], u.ballast_limit[i]);
+                for (s, arm) in [(0usize, -ls), (1usize, ls)] {
+                    let seat = x[izs + i] + arm * x[iph + i];
+                    let pad = -kp * (x[s * nk + node] - seat);
+                    let slack = if pad_on[s * ns + i] { tol } else { 0.0 };
+                    pads[s * ns + i] = pad >= -pad_lim - slack;
+                    let ballast = -kb * (seat + g);
+                    let slack = if ballast_on[s * ns + i] { tol } else { 0.0 };
+                    seats[s * ns + i] = ballast >= -lim - slack;
+                }
+            }
+            let changed = if pads != pad_on {
+                pad_on = pads;
+                true
+            } else if seats != ballast_on {
+                ballast_on = seats;
+                true
+            } else {
+                false
+            };
+            if !changed {
+                self.set_static_state(&x);
+                for i in 0..2 * ns {
+                    if !pad_on[i] {
+                        let at = (i / ns) * self.sp + i % ns;
+                        self.pad[at] = -pad_lim;
+                    }
+                }
+                // The supports lifted at the start, for no time yet.
+                let u = self.unilateral.as_mut().expect("supports that can lift");
+                let at_start = |on: &[bool], t: &mut [f64]| {
+                    for (t, &on) in t.iter_mut().zip(on) {
+                        *t = if on { CARRIES } else { 0.0 };
+                    }
+                };
+                at_start(&pad_on, &mut u.pad_lifted);
+                at_start(&ballast_on, &mut u.ballast_lifted);
+                (u.longest, u.longest_at) = (0.0, 0);
+                return Ok(());
+            }
+        }
+        Err(Error::Unsupported(format!(
+            "the static state of the track's lifting supports: the active-set \
+                 iteration did not settle in {MAX_PASSES} passes (give the pads and the \
+                 ballast their physical preloads, track.pad.preload and \
+                 track.ballast.preload)"
+        )))
     }
 }
