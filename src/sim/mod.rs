@@ -4,9 +4,12 @@
 //! extremes.
 
 mod accelerations;
+mod build;
 mod clock;
 mod health;
 mod inputs;
+mod motion;
+mod sampling;
 mod scenario;
 mod simulation;
 mod sites;
@@ -18,14 +21,13 @@ mod vehicle_unit;
 mod wheelset;
 
 pub use accelerations::Accelerations;
+pub use build::{CONTACT_STIFFNESS_MARGIN, default_dt};
 pub use clock::StepPlan;
 pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
     TrailingWheelset, VehicleSpec, VoidedSleepers, kmh,
 };
-pub use simulation::{
-    CONTACT_STIFFNESS_MARGIN, InputRates, Simulation, TrackState, VehicleState, default_dt,
-};
+pub use simulation::{InputRates, Simulation, TrackState, VehicleState};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};
 pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
 pub use wheelset::{Sample, Wheelset, Wheelsets};

@@ -3,7 +3,8 @@
 
 use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;
-use super::simulation::{InputRates, Motion, Simulation, TrackState, VehicleState};
+use super::motion::Motion;
+use super::simulation::{InputRates, Simulation, TrackState, VehicleState};
 use super::sites::Site;
 use crate::error::{Error, Result, num, out_of_range};
 use crate::limits::MIN_DT_FRACTION;

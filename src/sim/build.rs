@@ -1,0 +1,401 @@
+//! A simulation built from its scenario: the checks of every parameter, the time step
+//! and its stability limit, the endless track's window, the wheelsets and their
+//! vehicles, the static start.
+
+use super::clock::{Clock, Stepping};
+use super::motion::{Motion, Window};
+use super::simulation::InputRates;
+use super::simulation::{Simulation, TrackState, VehicleState};
+use super::sites::sites;
+use super::static_start::{contact_law, static_loads};
+use super::wheelset::{Wheelset, Wheelsets};
+use crate::contact::ContactLaw;
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
+use crate::limits::{MAX_WHEELSETS, MIN_DT_FRACTION, force_limit};
+use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
+use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
+use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use crate::wheel::WheelProfile;
+
+/// The contact stiffness passed to the track's stability limit is this many times the
+/// perfect wheel's `dP / d delta` at the force limit: a flat in the patch raises it by at
+/// most 2.03 times at equal force, and by 1.46 times at the force limit
+/// (`examples/stability_limit.rs`).
+pub const CONTACT_STIFFNESS_MARGIN: f64 = 2.0;
+
+/// Time step used when the scenario asks for the default (`dt = 0`) (s), without the
+/// contact's stiffness ([`Simulation::new`] takes it into account; the two agree for
+/// every physical contact: see `docs/VALIDATION.md`).
+pub fn default_dt(scenario: &Scenario) -> f64 {
+    match &scenario.track {
+        TrackSpec::Discrete(t) => DEFAULT_DT_FRACTION * t.critical_time_step().0,
+        TrackSpec::Lumped(_) => 1e-6,
+    }
+}
+
+/// The time step (s) of scenario `s` with contact law `law` under the static loads
+/// `static_load` (N), and the discrete track's critical step (s) with what sets it: the
+/// scenario's step, or [`DEFAULT_DT_FRACTION`] of the critical step when it is 0. The
+/// critical step includes [`CONTACT_STIFFNESS_MARGIN`] times the contact's stiffness
+/// under the force limit (table 4.2 and section 4.2.2 without the contact).
+///
+/// Errors: track parameters [`crate::track::TrackParams::validate`] refuses; a step
+/// above the critical step ([`Error::UnstableTimeStep`]) or below [`MIN_DT_FRACTION`] of
+/// it.
+fn time_step_of(
+    s: &Scenario,
+    track: &TrackSpec,
+    law: &ContactLaw,
+    static_load: [f64; 2],
+) -> Result<(f64, Option<(f64, String)>)> {
+    let critical = match track {
+        TrackSpec::Discrete(p) => {
+            p.validate()?;
+            let perfect = WheelProfile::perfect(s.wheel_radius)?;
+            let kc = law.stiffness(&perfect, 0.0, force_limit(static_load));
+            Some(p.critical_time_step_with_contact(CONTACT_STIFFNESS_MARGIN * kc))
+        }
+        TrackSpec::Lumped(_) => None,
+    };
+    let dt = match (s.dt, &critical) {
+        (0.0, Some((c, _))) => DEFAULT_DT_FRACTION * c,
+        (0.0, None) => default_dt(s),
+        (dt, _) => dt,
+    };
+    if let Some((c, limit)) = &critical {
+        if dt > *c {
+            return Err(Error::UnstableTimeStep {
+                dt,
+                critical: *c,
+                limit: limit.clone(),
+            });
+        }
+        if dt < MIN_DT_FRACTION * c {
+            return Err(out_of_range(
+                "solver.dt",
+                dt,
+                format!(
+                    "0 (the default, {} s) or {} s <= solver.dt <= {} s (the critical step; \
+                     a step below {MIN_DT_FRACTION} of it resolves nothing more)",
+                    num(DEFAULT_DT_FRACTION * c),
+                    num(MIN_DT_FRACTION * c),
+                    num(*c)
+                ),
+            ));
+        }
+    }
+    Ok((dt, critical))
+}
+
+/// Sets `p.spans` to the window `spec` around wheelsets `d_max` (m) long whose leading
+/// one starts at `x0` (m), and places the window: `ceil((ahead + behind + d_max) / a) +
+/// 1` spans, node 0 at the whole span `j = ceil((x0 - (L - ahead)) / a)`, so that at
+/// least `ahead` lies ahead of the leading wheelset and `behind` behind the last.
+///
+/// Errors: `ahead` or `behind` below [`MIN_WINDOW_SIDE`] or one sleeper spacing, or not
+/// finite; a window longer than the track may be.
+fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> Result<Window> {
+    let a = p.sleeper_spacing;
+    positive("track.sleeper_spacing", a, "m")?;
+    for (name, v) in [
+        ("track.window.ahead", spec.ahead),
+        ("track.window.behind", spec.behind),
+    ] {
+        finite(name, v, "m")?;
+        let least = MIN_WINDOW_SIDE.max(a);
+        if !(v >= least && v <= MAX_WINDOW_SIDE) {
+            return Err(out_of_range(
+                name,
+                v,
+                format!(
+                    "{} m <= {name} <= {MAX_WINDOW_SIDE} m (at least {MIN_WINDOW_SIDE} m and \
+                     one sleeper spacing; 20 m is converged)",
+                    num(least)
+                ),
+            ));
+        }
+    }
+    let spans = ((spec.ahead + spec.behind + d_max) / a).ceil() as usize + 1;
+    p.spans = spans;
+    let len = spans as f64 * a;
+    let j = ((x0 - (len - spec.ahead)) / a).ceil();
+    Ok(Window {
+        spec,
+        origin_span: j as i64,
+        shift_at: len - spec.ahead,
+        spacing: a,
+    })
+}
+
+/// Longest window side (m) ([`TrackWindow`]).
+pub const MAX_WINDOW_SIDE: f64 = 1000.0;
+/// Shortest window side (m) ([`TrackWindow`]): at 4 m a side the reference flat's peak
+/// is off by 0.12 % and its force history by 16 % of the static load
+/// (`examples/window_study.rs`); shorter windows are further off.
+pub const MIN_WINDOW_SIDE: f64 = 4.0;
+/// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
+/// below a step's travel (0.3 mm at 70 km/h), so positions integrate the speed.
+pub const MAX_START_POSITION: f64 = 1e7;
+
+impl Simulation {
+    /// Builds the models, checks every parameter and puts the system in static
+    /// equilibrium at the start position.
+    ///
+    /// Errors: a parameter outside its physical range ([`Error::Parameter`], naming
+    /// it); a time step above the critical step ([`Error::UnstableTimeStep`]); a start
+    /// outside the discrete track; a contact or track too soft to carry the static
+    /// wheel load; a static state beyond the health bounds.
+    pub fn new(scenario: &Scenario) -> Result<Self> {
+        let s = scenario;
+        // The half-car bogie's wheelbase is the second wheelset's offset here: a refusal
+        // names that, the variable a user of the scenario (CoupledSystem) sets.
+        if let VehicleSpec::HalfCar(p) = &s.vehicle {
+            p.validate().map_err(|e| {
+                e.renamed(
+                    "vehicle.wheelbase",
+                    "wheelset[2].offset",
+                    "(the half-car bogie's wheelbase)",
+                )
+            })?;
+        }
+        positive("wheel.radius", s.wheel_radius, "m")?;
+        finite("speed", s.speed, "m/s")?;
+        if s.speed < 0.0 {
+            return Err(out_of_range("speed", s.speed, ">= 0 m/s"));
+        }
+        finite("start_position", s.start_position, "m")?;
+        if s.start_position.abs() > MAX_START_POSITION {
+            return Err(out_of_range(
+                "start_position",
+                s.start_position,
+                format!(
+                    "-{MAX_START_POSITION:e} m <= start_position <= {MAX_START_POSITION:e} m \
+                     (positions along the line keep 1e-9 m of resolution there)"
+                ),
+            ));
+        }
+        non_negative("solver.dt", s.dt, "s")?;
+        non_negative("contact.Kw", s.kw, "N/m/rad")?;
+        non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
+        if s.trailing.len() + 1 > MAX_WHEELSETS {
+            return Err(out_of_range(
+                "wheelsets",
+                (s.trailing.len() + 1) as f64,
+                format!("1 to {MAX_WHEELSETS} wheelsets"),
+            ));
+        }
+        for (k, w) in s.trailing.iter().enumerate() {
+            let name = format!("wheelset[{}].offset", k + 2);
+            positive(&name, w.offset, "m")?;
+            let before = if k == 0 {
+                0.0
+            } else {
+                s.trailing[k - 1].offset
+            };
+            // Wheels of the same rail cannot overlap: one wheel diameter apart at least.
+            let least = before + 2.0 * s.wheel_radius;
+            if w.offset.is_nan() || w.offset < least {
+                return Err(out_of_range(
+                    &name,
+                    w.offset,
+                    format!(
+                        ">= {} m, the wheelset ahead's offset {} m plus a wheel diameter \
+                         (wheelsets in order, the leading one first)",
+                        num(least),
+                        num(before)
+                    ),
+                ));
+            }
+        }
+        // The contact law first: its stiffness under the largest force a run reaches
+        // enters the stability limit of the track.
+        let static_load = static_loads(&s.vehicle)?;
+        let law = contact_law(s, static_load)?;
+        let mut track_spec = s.track;
+        let mut window = None;
+        let d_max = s.trailing.last().map_or(0.0, |w| w.offset);
+        if let Some(spec) = s.window {
+            let TrackSpec::Discrete(p) = &mut track_spec else {
+                return Err(Error::Unsupported(
+                    "an endless track of the lumped model (it has no rails)".into(),
+                ));
+            };
+            window = Some(window_spans(p, spec, d_max, s.start_position)?);
+        }
+        let (dt, critical) = time_step_of(s, &track_spec, &law, static_load)?;
+        let (frame_inertia, shared_side_frames) = match &s.vehicle {
+            VehicleSpec::AxleBox { side_frames, .. } => side_frames.inertia(s)?,
+            _ => (crate::vehicle::SideFrameInertia::single(1.0), false),
+        };
+        let vehicle = || -> Result<VehicleState> {
+            Ok(match &s.vehicle {
+                VehicleSpec::RollPlane(p) => {
+                    VehicleState::RollPlane(RollPlaneVehicle::new(*p, dt)?)
+                }
+                VehicleSpec::LumpedWheels(p) => {
+                    VehicleState::LumpedWheels(LumpedWheels::new(*p, dt)?)
+                }
+                VehicleSpec::ConstantLoad(p) => VehicleState::ConstantLoad(*p),
+                VehicleSpec::AxleBox { vehicle, .. } => VehicleState::AxleBox(
+                    crate::vehicle::PrimaryLink::new(vehicle, dt, frame_inertia)?,
+                ),
+                VehicleSpec::HalfCar(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
+                VehicleSpec::External { .. } => VehicleState::External {
+                    wheel_z: [0.0; 2],
+                    rotation: 0.0,
+                    since: 0.0,
+                    rates: InputRates::default(),
+                },
+            })
+        };
+        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?
+            .with_roundness(s.roundness.clone());
+        let trailing = s
+            .trailing
+            .iter()
+            .zip(2..)
+            .map(|(w, k)| {
+                let name = format!("wheelset[{k}].");
+                Ok(
+                    Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?, &name)?
+                        .with_roundness(w.roundness.clone()),
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let wheelsets = Wheelsets::new(lead, trailing);
+        let bogie = match &s.vehicle {
+            VehicleSpec::HalfCar(p) => Some(Box::new(half_car_on(p, s, dt)?)),
+            _ => None,
+        };
+        let origin = window.map_or(0.0, |w: Window| w.origin());
+        let track = match &track_spec {
+            TrackSpec::Discrete(p) => {
+                p.validate()?;
+                let len = p.length();
+                for w in wheelsets.iter() {
+                    let x = w.position(s.start_position) - origin;
+                    if !(x > 0.0 && x < len) {
+                        return Err(out_of_range(
+                            "start_position",
+                            s.start_position,
+                            format!(
+                                "every wheelset inside the track, 0 < x < {len} m (wheelset at \
+                                 {} m behind the leading one: {} m; an endless track, \
+                                 track.window.ahead > 0, carries wheelsets anywhere)",
+                                num(w.offset()),
+                                num(x)
+                            ),
+                        ));
+                    }
+                }
+                TrackState::Discrete(Track::new(*p, dt)?)
+            }
+            TrackSpec::Lumped(p) => {
+                if wheelsets.len() > 1 {
+                    return Err(Error::Unsupported(
+                        "several wheelsets on the lumped track (one mass under one wheel)".into(),
+                    ));
+                }
+                TrackState::Lumped(LumpedTrack::new(*p, dt)?)
+            }
+        };
+        let load = PointLoad {
+            rail: 0,
+            position: 0.0,
+            force: 0.0,
+        };
+        let mut scenario = s.clone();
+        scenario.track = track_spec;
+        let mut sim = Simulation {
+            scenario,
+            track,
+            loads: vec![load; 2 * wheelsets.len()],
+            wheelsets,
+            motion: Motion {
+                x_ref: s.start_position,
+                t_ref: 0.0,
+                speed: s.speed,
+                rotation_ref: 0.0,
+            },
+            origin,
+            window,
+            law,
+            clock: Clock::new(dt, Stepping::Grid),
+            steps: 0,
+            static_load,
+            critical_step: critical.map_or(f64::NAN, |c| c.0),
+            force_limit: force_limit(static_load),
+            simd: SimdLevel::detect(),
+            sites: Vec::new(),
+            bogie,
+            shared_side_frames,
+            voids: s.voids,
+            irregular: s.rails.iter().any(RailProfile::is_some)
+                || s.roundness
+                    .iter()
+                    .chain(s.trailing.iter().flat_map(|w| &w.roundness))
+                    .any(Option::is_some),
+            rails: s.rails.clone(),
+        };
+        if let (Some(v), None, TrackState::Discrete(t)) = (&sim.voids, &sim.window, &sim.track) {
+            // On a fixed track every hanging sleeper must be one of its sleepers.
+            let (a, spans) = (t.params().sleeper_spacing, t.params().spans);
+            let first = (v.position / a).round();
+            if !(first >= 0.0 && first + v.sleepers as f64 - 1.0 <= spans as f64) {
+                return Err(out_of_range(
+                    "track.void.position",
+                    v.position,
+                    format!(
+                        "a run of track.void.sleepers = {} sleepers within the fixed track's {} \
+                         sleepers: -{} m <= track.void.position < {} m",
+                        v.sleepers,
+                        spans + 1,
+                        num(0.5 * a),
+                        num((spans as f64 + 1.5 - v.sleepers as f64) * a)
+                    ),
+                ));
+            }
+        }
+        sim.place_voids()?;
+        sim.set_static()?;
+        sim.check_static_sag()?;
+        sim.check_states()?;
+        match &sim.track {
+            TrackState::Discrete(t) => {
+                sim.sites = sites(t, sim.origin, sim.window.is_some(), &s.sites)?
+            }
+            TrackState::Lumped(_) if !s.sites.is_empty() => {
+                return Err(Error::Unsupported(
+                    "observation points on the lumped track (it has no rails)".into(),
+                ));
+            }
+            TrackState::Lumped(_) => {}
+        }
+        Ok(sim)
+    }
+}
+
+/// The half-car bogie of `p` for the scenario `s`, stepped with `dt` (s): it needs
+/// exactly two wheelsets, the trailing one at the bogie's wheelbase.
+///
+/// Errors: another number of wheelsets (named `wheelsets`), a trailing offset other
+/// than the wheelbase (named `wheelset[2].offset`), the bogie's own refusals
+/// ([`HalfCarBogie::new`]).
+fn half_car_on(p: &crate::vehicle::HalfCarParams, s: &Scenario, dt: f64) -> Result<HalfCarBogie> {
+    if s.trailing.len() != 1 {
+        return Err(out_of_range(
+            "wheelsets",
+            (s.trailing.len() + 1) as f64,
+            "2 with the half-car bogie (vehicle.model = half_car): its two wheelsets",
+        ));
+    }
+    let offset = s.trailing[0].offset;
+    if (offset - p.wheelbase).abs() > 1e-9 * p.wheelbase {
+        return Err(out_of_range(
+            "wheelset[2].offset",
+            offset,
+            format!("the half-car bogie's wheelbase, {} m", num(p.wheelbase)),
+        ));
+    }
+    HalfCarBogie::new(*p, dt)
+}
