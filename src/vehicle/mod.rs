@@ -11,6 +11,9 @@
 //! * [`HalfCarParams`]: the thesis' half-car bogie (figure 1.10), ten degrees of
 //!   freedom, its matrices, natural frequencies and static state; [`HalfCarBogie`]
 //!   and [`SprungHalfCar`] advance it in time, whole or above its primary suspension.
+//! * [`WagonParams`]: a four-axle freight wagon, the car body in bounce, pitch and roll
+//!   on two half-car bogies, nineteen degrees of freedom, its matrices, natural
+//!   frequencies and static state (issue 28; not yet in time or in an FMU).
 //! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
 //!   (the primary suspension), for a bogie model that couples at its own step.
 //!
@@ -24,6 +27,9 @@ mod lumped;
 mod roll_plane;
 #[cfg(test)]
 mod tests;
+mod wagon;
+#[cfg(test)]
+mod wagon_tests;
 
 pub use axle_box::{PrimaryLink, SideFrameInertia, SprungBogie, WheelsetBody};
 pub use exchange::{CONTACT_STIFFNESS, ExchangeLimits};
@@ -33,3 +39,4 @@ pub use half_car::{
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
+pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
