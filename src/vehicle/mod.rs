@@ -13,7 +13,8 @@
 //!   and [`SprungHalfCar`] advance it in time, whole or above its primary suspension.
 //! * [`WagonParams`]: a four-axle freight wagon, the car body in bounce, pitch and roll
 //!   on two half-car bogies, nineteen degrees of freedom, its matrices, natural
-//!   frequencies and static state (issue 28; not yet in time or in an FMU).
+//!   frequencies and static state; [`Wagon`] advances it in time (issue 28; not yet in
+//!   an FMU).
 //! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
 //!   (the primary suspension), for a bogie model that couples at its own step.
 //!
@@ -39,4 +40,4 @@ pub use half_car::{
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
-pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
+pub use wagon::{Octet, WAGON_DOFS, Wagon, WagonMatrix, WagonParams, WagonVector, bogie_start};
