@@ -3,9 +3,11 @@
 //! [`FmuModel`] that implements [`crate::fmu::fmi2::Model`].
 
 mod datum;
+mod derivatives;
 mod outputs;
 mod parameters;
 mod unit;
+mod warnings;
 mod watch;
 
 pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};

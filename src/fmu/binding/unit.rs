@@ -4,9 +4,10 @@
 
 use super::Kind;
 use super::datum::InputDatum;
+use super::derivatives::{name_of, no_derivative, wheel_input};
 use super::outputs::Published;
 use super::parameters::{check_table, scenario, vehicle_unit_params, with_tables};
-use super::watch::{ContactWatch, HELD_STEPS, INTERPOLATED_STEPS};
+use super::watch::ContactWatch;
 use crate::error::{Error, num};
 use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
 use crate::fmu::vars::{
@@ -22,7 +23,7 @@ pub const END_ZONE_SPANS: f64 = 2.0;
 
 /// TrackContact's side-frame inputs of the leading wheelset (`interface = axle_box`):
 /// left and right displacement, left and right velocity.
-const FRAME_VRS: [u32; 4] = [
+pub(super) const FRAME_VRS: [u32; 4] = [
     vr::SIDEFRAME_LEFT_Z,
     vr::SIDEFRAME_RIGHT_Z,
     vr::SIDEFRAME_LEFT_V,
@@ -96,120 +97,6 @@ fn fitted_step(sim: &Simulation, h: f64) -> Option<f64> {
     (fitted >= 0.5 * dt).then_some(fitted)
 }
 
-/// Why the forces that drove a vehicle's first step do not hold it at rest (more than
-/// 1 % off, wheel by wheel), in words; `None` when they do.
-fn off_rest(u: &VehicleUnit) -> Option<String> {
-    let (names, partner) = if u.is_axle_box() {
-        (
-            "axle_box.*.force",
-            "TrackContact's static_load.* (and its vehicle.wheelset.*, vehicle.primary.*, gravity) \
-             to this vehicle's",
-        )
-    } else {
-        (
-            "contact.*.force",
-            "TrackContact's static_load.* to this vehicle's",
-        )
-    };
-    let mut worst: Option<(f64, f64, f64)> = None;
-    for k in 0..u.wheelsets() {
-        let (Some(held), Some(rest)) = (u.held_forces_of(k), u.rest_forces_of(k)) else {
-            continue;
-        };
-        for s in 0..2 {
-            let off = (held[s] - rest[s]).abs() / rest[s].abs().max(1.0);
-            if off > 0.01 && worst.is_none_or(|(o, _, _)| off > o) {
-                worst = Some((off, held[s], rest[s]));
-            }
-        }
-    }
-    let (off, held, rest) = worst?;
-    let load = u.static_load();
-    Some(format!(
-        "the {names} that drove the first step ({} N) are {:.1} % off the {} N that hold this \
-         vehicle at rest: its partner does not carry it at rest and it will start moving; \
-         set {partner} (static_load.left = {} N, static_load.right = {} N)",
-        num(held),
-        100.0 * off,
-        num(rest),
-        num(load[0]),
-        num(load[1])
-    ))
-}
-
-/// The refusal of derivatives of value reference `r`.
-fn no_derivative(r: u32) -> Error {
-    Error::Unsupported(format!(
-        "derivatives of `{}`: TrackContact interpolates wheel.*.z (orders 1 and 2) and \
-         wheel.rotation (order 1) of each wheelset, with the contact interface; \
-         RollPlaneVehicle and HalfCarBogie give the first derivatives of wheel.*.z, \
-         wheel.rotation and sideframe.*.z",
-        name_of(r)
-    ))
-}
-
-/// The variable name of value reference `r`.
-fn name_of(r: u32) -> String {
-    crate::fmu::vars::FMUS
-        .iter()
-        .flat_map(|t| t.vars.iter())
-        .find(|v| v.vr == r)
-        .map_or_else(|| format!("value reference {r}"), |v| v.name.to_string())
-}
-
-/// The wheelset (0 the leading one) and input (0 left height, 1 right height, 2 axle
-/// angle) of the wheel input (or vehicle output) `r`.
-fn wheel_input(r: u32) -> Option<(usize, usize)> {
-    let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
-    std::iter::once(lead)
-        .chain(TRAILING_INPUT_VRS)
-        .enumerate()
-        .find_map(|(k, refs)| refs.iter().position(|&x| x == r).map(|i| (k, i)))
-}
-
-/// The wheelset, side and quantity of a contact output `r` of TrackContact.
-fn contact_output(r: u32) -> Option<(usize, usize, crate::fmu::vars::Quantity)> {
-    use crate::fmu::vars::Quantity;
-    let &Some((q, side, k)) = crate::fmu::vars::QUANTITIES.get(r as usize)? else {
-        return None;
-    };
-    match q {
-        Quantity::ContactForce
-        | Quantity::ContactOverlap
-        | Quantity::ContactFrontAngle
-        | Quantity::ContactRearAngle
-        | Quantity::ContactLength
-        | Quantity::ContactMaxForce
-        | Quantity::ContactMinForce
-        | Quantity::RailZ
-        | Quantity::WheelAcceleration
-        | Quantity::RailAcceleration => Some((k, side, q)),
-        _ => None,
-    }
-}
-
-/// The wheelset and side of a primary-force output `r` of TrackContact (at the point or
-/// the mean, `interface = axle_box`).
-fn primary_output(r: u32) -> Option<(usize, usize)> {
-    use crate::fmu::vars::Quantity;
-    let &Some((q, side, k)) = crate::fmu::vars::QUANTITIES.get(r as usize)? else {
-        return None;
-    };
-    matches!(q, Quantity::PrimaryForce | Quantity::PrimaryMeanForce).then_some((k, side))
-}
-
-/// The wheelset, side and whether it is the velocity of a side-frame input `r`.
-fn frame_input(r: u32) -> Option<(usize, usize, bool)> {
-    std::iter::once(FRAME_VRS)
-        .chain(TRAILING_FRAME_VRS)
-        .enumerate()
-        .find_map(|(k, refs)| {
-            refs.iter()
-                .position(|&x| x == r)
-                .map(|i| (k, i % 2, i >= 2))
-        })
-}
-
 /// The engine behind an FMU.
 #[derive(Debug, Clone)]
 pub(super) enum Engine {
@@ -222,23 +109,23 @@ pub(super) enum Engine {
 /// The model of one of the three FMUs ([`Kind`]) behind the FMI 2.0 layer.
 #[derive(Debug, Clone)]
 pub struct FmuModel {
-    kind: Kind,
+    pub(super) kind: Kind,
     pub(super) engine: Engine,
     pub(super) published: Published,
     /// The largest force a physical run reaches (N), [`force_limit`] of the static
     /// loads.
-    force_limit: f64,
+    pub(super) force_limit: f64,
     /// The last communication step (s), for the vehicles' warning of an axle-box
     /// exchange beyond its stable step.
-    last_step: f64,
+    pub(super) last_step: f64,
     /// Where TrackContact's displacement inputs are measured from (`inputs.datum`).
-    datum: InputDatum,
+    pub(super) datum: InputDatum,
     /// What TrackContact sees of its exchange at the contact interface.
-    watch: ContactWatch,
+    pub(super) watch: ContactWatch,
     /// The end of the master's last step, in model time (s).
-    master_end: f64,
+    pub(super) master_end: f64,
     /// A vehicle's first step was checked against its forces at rest.
-    started: bool,
+    pub(super) started: bool,
 }
 
 impl FmuModel {
@@ -598,162 +485,7 @@ impl Model for FmuModel {
     /// TrackContact at the contact interface, what its contact watch sees (`watch.rs`); for a vehicle's
     /// first step, forces off its forces at rest.
     fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
-        if let Engine::Vehicle(u) = &self.engine {
-            // The forces that drove the first step against those that hold this vehicle
-            // at rest: a partner that does not carry it at rest.
-            if !self.started {
-                self.started = true;
-                if let Some(w) = off_rest(u) {
-                    return Some(("static load", w));
-                }
-            }
-            let e = u.exchange_limits()?;
-            let h = self.last_step;
-            return (h > e.jacobi).then(|| {
-                let message = if h > e.sequential {
-                    format!(
-                        "at t = {time} s the communication step {} s is above {} s, the \
-                         largest at which the axle-box exchange stays stable under any master \
-                         (estimated from the exchange's amplification matrix with the primary \
-                         springs and dampers vehicle.primary.* and the side frames' inertia): \
-                         expect it to diverge; use steps of at most {} s",
-                        num(h),
-                        num(e.sequential),
-                        num(e.jacobi)
-                    )
-                } else {
-                    format!(
-                        "at t = {time} s the communication step {} s is above {} s, the \
-                         largest at which the axle-box exchange stays stable under a Jacobi \
-                         master (OSP libcosim, ecos: every unit steps from the same point), \
-                         estimated from the exchange's amplification matrix with the primary \
-                         springs and dampers vehicle.primary.* and the side frames' inertia; \
-                         under such a master expect it to diverge and use steps of at most {} \
-                         s. A sequential master that steps TrackContact first and hands this \
-                         unit its primary.*.mean_force stays stable to {} s",
-                        num(h),
-                        num(e.jacobi),
-                        num(e.jacobi),
-                        num(e.sequential)
-                    )
-                };
-                ("axle-box step", message)
-            });
-        }
-        let Engine::Sim(sim) = &self.engine else {
-            return None;
-        };
-        // TrackContact at the contact interface: what it sees of the exchange (the
-        // watch follows every step, whichever warning is returned).
-        let mut contact = None;
-        if self.kind == Kind::TrackContact && matches!(sim.vehicle(), VehicleState::External { .. })
-        {
-            let load = sim.static_load()[0].max(sim.static_load()[1]);
-            // No list built at every step: the wheelsets' forces as they come.
-            let forces = sim.wheelsets().iter().map(|w| w.forces());
-            let chatter = self.watch.forces_at_point(forces, load);
-            let jump = self.watch.take_jump(load);
-            let held = !sim.wheelsets().iter().any(|w| match w.vehicle() {
-                VehicleState::External { rates, .. } => rates.moves(),
-                _ => false,
-            });
-            let ratio = self.last_step / sim.dt();
-            let most = if held { HELD_STEPS } else { INTERPOLATED_STEPS };
-            contact = if let Some(name) = chatter {
-                Some((
-                    "contact chatter",
-                    format!(
-                        "at t = {time} s {name} has jumped up and down at each of the last \
-                     communication points: the contact exchange chatters, its forces are \
-                     numerical; the communication step {} s ({ratio:.1} track steps) is beyond \
-                     what an explicit exchange of the stiff contact tolerates; use the \
-                     track's step solver.step = {} s, or the axle-box interface (interface = \
-                     axle_box) for a vehicle model that steps at a millisecond",
-                        num(self.last_step),
-                        num(sim.dt())
-                    ),
-                ))
-            } else if let Some((j, name)) = jump {
-                Some((
-                    "contact exchange",
-                    format!(
-                        "at t = {time} s {name} jumped by {} N ({:.0} % of the static load) when \
-                     the wheel heights of this communication point came in: the heights the \
-                     vehicle returns are far from those the track held over the step, so the \
-                     contact exchange chatters and its forces are numerical; the \
-                     communication step {} s ({ratio:.1} track steps) is beyond what an \
-                     explicit exchange of the stiff contact tolerates; use the track's step \
-                     solver.step = {} s, or the axle-box interface (interface = axle_box) for \
-                     a vehicle model that steps at a millisecond",
-                        num(j),
-                        100.0 * j / load,
-                        num(self.last_step),
-                        num(sim.dt())
-                    ),
-                ))
-            } else if self.watch.is_coupled() && (ratio - ratio.round()).abs() > 1e-3 {
-                Some((
-                    "contact step grid",
-                    format!(
-                        "at t = {time} s the communication step {} s is {ratio:.3} track steps \
-                     (solver.step = {} s): the track steps on its own grid, so the wheel \
-                     heights and contact forces meet at other times than the master's (the \
-                     peak of the reference flat +4.7 % at half a track step); use a whole \
-                     number of solver.step",
-                        num(self.last_step),
-                        num(sim.dt())
-                    ),
-                ))
-            } else if ratio > most && self.watch.is_coupled() {
-                Some((
-                    "contact step",
-                    format!(
-                        "at t = {time} s the communication step {} s is {ratio:.1} track steps \
-                     (solver.step = {} s) with {}: the contact exchange's error grows with \
-                     the step (peak of the reference flat: held heights +1.1 %, +4.2 %, +12 % \
-                     at 2, 5, 10 track steps under a sequential master, +2.2 %, +7.0 %, +19 % \
-                     under a Jacobi one; with the wheel velocities +0.7 % at 5, +3.3 % at 10); \
-                     use at most {} s, give the wheel velocities (fmi2SetRealInputDerivatives), \
-                     or couple at the axle boxes (interface = axle_box)",
-                        num(self.last_step),
-                        num(sim.dt()),
-                        if held {
-                            "the wheel heights held over it"
-                        } else {
-                            "the wheel heights extrapolated with their derivatives"
-                        },
-                        num(most.floor() * sim.dt())
-                    ),
-                ))
-            } else {
-                self.watch
-                    .rate_warning()
-                    .map(|m| ("axle rate", format!("at t = {time} s {m}")))
-            };
-        }
-        let TrackSpec::Discrete(p) = &sim.scenario().track else {
-            return contact;
-        };
-        if sim.window().is_some() {
-            return contact;
-        }
-        let zone = p.length() - END_ZONE_SPANS * p.sleeper_spacing;
-        let x = sim.position();
-        if x <= zone {
-            return contact;
-        }
-        Some({
-            (
-                "rail end",
-                format!(
-                    "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans \
-                 of the fixed rail end at {:.3} m: the end's reflections raise impact forces \
-                 here (by 20 to 35 % within the last span); keep the impacts of interest at \
-                 least {END_ZONE_SPANS} spans from the ends (track.spans)",
-                    p.length()
-                ),
-            )
-        })
+        self.warning_after_step(time)
     }
 
     /// The engine's state, then TrackContact's input datum.
@@ -833,50 +565,7 @@ impl Model for FmuModel {
     /// velocities (backward differences over the last step) and the axle's rate
     /// `speed / wheel.radius`.
     fn output_derivative(&self, r: u32, order: i32) -> Result<f64, Error> {
-        let Engine::Vehicle(u) = &self.engine else {
-            return Err(no_derivative(r));
-        };
-        if order != 1 {
-            return Err(no_derivative(r));
-        }
-        if let Some((k, which)) = wheel_input(r) {
-            return match which {
-                2 => Ok(u.params().speed / u.params().wheel_radius),
-                side => u
-                    .wheel_velocity_of(k)
-                    .map(|v| v[side])
-                    .ok_or_else(|| no_derivative(r)),
-            };
-        }
-        let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
-        for (k, [zl, zr, _, _]) in frames.enumerate() {
-            if r == zl || r == zr {
-                let side = usize::from(r == zr);
-                return u
-                    .side_frames_of(k)
-                    .map(|(_, v)| v[side])
-                    .ok_or_else(|| no_derivative(r));
-            }
-        }
-        // The extremes are piecewise constant: 0 between their jumps.
-        use crate::fmu::vars::Quantity;
-        if let Some(Some((Quantity::ContactMaxForce | Quantity::ContactMinForce, _, _))) =
-            crate::fmu::vars::QUANTITIES.get(r as usize)
-        {
-            return Ok(0.0);
-        }
-        // Every other output: its rate over one more substep under the held inputs, a
-        // forward difference (first order in the substep; the held forces' is 0).
-        let dt = u.dt();
-        let mut ahead = self.clone();
-        if let Engine::Vehicle(t) = &mut ahead.engine {
-            t.advance(dt, 0.0)?;
-        }
-        let (now, next) = (
-            self.output(&self.outputs(), r),
-            ahead.output(&ahead.outputs(), r),
-        );
-        Ok((next - now) / dt)
+        self.vehicle_output_derivative(r, order)
     }
 
     /// TrackContact, every pair its model description declares. Contact interface:
@@ -892,133 +581,7 @@ impl Model for FmuModel {
     /// description does not declare is 0; before the first step, the displacement
     /// inputs stand for the static state (`inputs.datum = first_step`): 0.
     fn partial_derivative(&self, unknown: u32, known: u32) -> Result<f64, Error> {
-        use crate::fmu::vars::Quantity;
-        let Engine::Sim(sim) = &self.engine else {
-            return Err(Error::Unsupported(format!(
-                "the derivative of `{}` with respect to `{}`: only TrackContact gives \
-                 directional derivatives",
-                name_of(unknown),
-                name_of(known)
-            )));
-        };
-        if let VehicleState::AxleBox(_) = sim.vehicle() {
-            let (Some((ku, su)), Some((kk, sk, velocity))) =
-                (primary_output(unknown), frame_input(known))
-            else {
-                return Ok(0.0);
-            };
-            let Some(VehicleState::AxleBox(link)) = sim.wheelsets().get(ku).map(|w| w.vehicle())
-            else {
-                return Ok(0.0);
-            };
-            if ku != kk || su != sk || (!velocity && self.datum.follows(ku)) {
-                return Ok(0.0);
-            }
-            return Ok(if velocity {
-                -link.damping()
-            } else {
-                -link.stiffness()
-            });
-        }
-        let (Some((ku, side, q)), Some((kk, which))) =
-            (contact_output(unknown), wheel_input(known))
-        else {
-            return Ok(0.0);
-        };
-        let Some(sample) = sim.sample_of(ku) else {
-            return Ok(0.0);
-        };
-        if ku != kk || (which != 2 && which != side) {
-            return Ok(0.0);
-        }
-        // Before the first step the wheel heights stand for the static state
-        // (`inputs.datum = first_step`): the outputs do not follow them yet.
-        if which != 2 && self.datum.follows(ku) {
-            return Ok(0.0);
-        }
-        let w = sim.wheelsets().get(ku).expect("the sample's wheelset");
-        let wheel = &w.wheels()[side];
-        let law = sim.contact_law();
-        let overlap = sample.contact[side].overlap;
-        let gamma = sample.rotation;
-        // The rail's local compliance `c` under the wheel, in series with the contact
-        // (the force solves `P = P_law(overlap_0 - c P)`): a change of the overlap the
-        // nodes give moves the overlap by `s = 1 / (1 + c k)` of it.
-        let c = sim.contact_compliance_of(ku);
-        let k = law.stiffness_at(wheel, gamma, overlap);
-        let s = 1.0 / (1.0 + c * k);
-        // Central differences of the law's state in the overlap and the axle angle.
-        let d_overlap = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
-            let e = 1e-9;
-            (pick(&law.evaluate(wheel, gamma, overlap + e))
-                - pick(&law.evaluate(wheel, gamma, overlap - e)))
-                / (2.0 * e)
-        };
-        let d_gamma = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
-            let e = 1e-7;
-            (pick(&law.evaluate(wheel, gamma + e, overlap))
-                - pick(&law.evaluate(wheel, gamma - e, overlap)))
-                / (2.0 * e)
-        };
-        // The wheel's out-of-roundness at the angle that touches the rail moves the
-        // overlap with the axle angle by `dr/d gamma`.
-        let rp = w.radius_deviation_slope(side, gamma);
-        // dP/d gamma with the overlap following it through the compliance.
-        let p_gamma = || s * (d_gamma(&|c| c.force) + k * rp);
-        // A quantity of the state: a height raises the overlap by `-s` per metre, the
-        // axle angle moves it by `-c dP/d gamma`.
-        let difference = |pick: &dyn Fn(&crate::contact::ContactState) -> f64| -> f64 {
-            if which == 2 {
-                d_gamma(pick) + (rp - c * p_gamma()) * d_overlap(pick)
-            } else {
-                -s * d_overlap(pick)
-            }
-        };
-        let force = || {
-            if which == 2 { p_gamma() } else { -k * s }
-        };
-        let p = sample.contact[side].force;
-        Ok(match q {
-            Quantity::ContactForce => force(),
-            Quantity::ContactOverlap => {
-                if which == 2 {
-                    rp - c * p_gamma()
-                } else {
-                    -s
-                }
-            }
-            // The rail under the wheel, lowered by `c P`.
-            Quantity::RailZ => {
-                if which == 2 {
-                    -c * p_gamma()
-                } else {
-                    c * k * s
-                }
-            }
-            Quantity::ContactFrontAngle => difference(&|c| c.front_angle),
-            Quantity::ContactRearAngle => difference(&|c| c.rear_angle),
-            Quantity::ContactLength => difference(&|c| c.length),
-            // The extreme is the force now where the force is beyond the extremes of the
-            // steps taken.
-            Quantity::ContactMaxForce if p >= w.max_force()[side] => force(),
-            Quantity::ContactMinForce if p <= w.min_force()[side] => force(),
-            // Accelerations: `1 / dt^2` of the displacement's derivative (the extremes
-            // are of the steps taken: no feedthrough).
-            Quantity::WheelAcceleration | Quantity::RailAcceleration => {
-                let wheel = q == Quantity::WheelAcceleration;
-                let signal = if wheel { side } else { 2 + side };
-                // The wheel's height moves the wheel one for one, its rotation not; the
-                // rail under the wheel as `rail.*.z`.
-                let dz = match (wheel, which == 2) {
-                    (true, true) => 0.0,
-                    (true, false) => 1.0,
-                    (false, true) => -c * p_gamma(),
-                    (false, false) => c * k * s,
-                };
-                w.acceleration_record().gain(signal) * dz
-            }
-            _ => 0.0,
-        })
+        self.directional_derivative(unknown, known)
     }
 
     fn model_time(&self) -> (f64, f64) {
