@@ -3,11 +3,12 @@
 //! vehicles, the static start.
 
 use super::clock::{Clock, Stepping};
+use super::inputs::InputRates;
 use super::motion::{Motion, Window};
-use super::simulation::InputRates;
-use super::simulation::{Simulation, TrackState, VehicleState};
+use super::simulation::{Simulation, TrackState};
 use super::sites::sites;
 use super::static_start::{contact_law, static_loads};
+use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};

@@ -1,7 +1,8 @@
 //! The health checks of a run: every state and every sample against the bounds of
 //! [`crate::limits`] that no physical run passes, with the likely cause in words.
 
-use super::simulation::{Simulation, TrackState, VehicleState};
+use super::simulation::{Simulation, TrackState};
+use super::vehicle_state::VehicleState;
 use super::wheelset::{Sample, Wheelset};
 use crate::error::{Error, Result, num};
 use crate::limits::{DISPLACEMENT_LIMIT, within};

@@ -17,17 +17,20 @@ mod state;
 mod static_start;
 #[cfg(test)]
 mod tests;
+mod vehicle_state;
 mod vehicle_unit;
 mod wheelset;
 
 pub use accelerations::Accelerations;
 pub use build::{CONTACT_STIFFNESS_MARGIN, default_dt};
 pub use clock::StepPlan;
+pub use inputs::InputRates;
 pub use scenario::{
     DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
     TrailingWheelset, VehicleSpec, VoidedSleepers, kmh,
 };
-pub use simulation::{InputRates, Simulation, TrackState, VehicleState};
+pub use simulation::{Simulation, TrackState};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};
+pub use vehicle_state::VehicleState;
 pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
 pub use wheelset::{Sample, Wheelset, Wheelsets};

@@ -2,7 +2,8 @@
 //! speed and the axles' rotation, the window that moves with the wheelsets by whole
 //! sleeper spans, and what is fixed in line coordinates on it (the hanging sleepers).
 
-use super::simulation::{Simulation, TrackState, VehicleState};
+use super::simulation::{Simulation, TrackState};
+use super::vehicle_state::VehicleState;
 use super::wheelset::Wheelset;
 use crate::error::{Error, Result};
 use crate::sim::TrackWindow;

@@ -2,7 +2,8 @@
 //! every wheelset (wheel and rail displacements, the contact states), computed once per
 //! instant and cached, with the rail's local compliance and the irregularities there.
 
-use super::simulation::{Simulation, TrackState, VehicleState, at_level};
+use super::simulation::{Simulation, TrackState, at_level};
+use super::vehicle_state::VehicleState;
 use super::wheelset::{Sample, Wheelset, contact_states};
 
 impl Simulation {

@@ -9,13 +9,14 @@
 use super::clock::{Clock, StepPlan};
 use super::motion::{Motion, Window};
 use super::sites::Site;
+use super::vehicle_state::VehicleState;
 use super::wheelset::{Sample, Wheelset, Wheelsets, contact_states, wheel_loads};
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result, non_negative, num};
 use crate::limits::{DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, within};
 use crate::sim::{Scenario, VoidedSleepers};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track};
-use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use crate::vehicle::{HalfCarBogie, LumpedTrack};
 
 /// Track state of a simulation.
 // Not boxed: the variant is touched every step and there is one per simulation.
@@ -26,141 +27,6 @@ pub enum TrackState {
     Discrete(Track),
     /// Chapter-2 lumped track.
     Lumped(LumpedTrack),
-}
-
-/// Vehicle state of a simulation.
-#[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone)]
-pub enum VehicleState {
-    /// Six-DOF roll-plane vehicle.
-    RollPlane(RollPlaneVehicle),
-    /// Chapter-2 lumped wheels.
-    LumpedWheels(LumpedWheels),
-    /// Constant loads (N), no contact.
-    ConstantLoad([f64; 2]),
-    /// The wheelset of the roll-plane vehicle with its primary suspension, the bogie
-    /// above it outside ([`crate::vehicle::PrimaryLink`]): the side frames' motion is
-    /// the input, the primary forces the output.
-    AxleBox(crate::vehicle::PrimaryLink),
-    /// A wheelset of the half-car bogie ([`Simulation::bogie`]), which moves its
-    /// wheels: their displacements `[left, right]` (m) after the bogie's last step.
-    OnBogie {
-        /// Wheel-centre displacements `[left, right]` (m).
-        wheel_z: [f64; 2],
-    },
-    /// Wheels moved from outside.
-    External {
-        /// Wheel-centre displacements `[left, right]` (m), inputs.
-        wheel_z: [f64; 2],
-        /// Axle rotation angle (rad) given at `since`.
-        rotation: f64,
-        /// Time (s) at which `rotation` was given; between inputs the axle turns at
-        /// `V / R_w`.
-        since: f64,
-        /// The inputs' time derivatives, when the master gives them (FMI's
-        /// `fmi2SetRealInputDerivatives`); zero: the inputs are held.
-        rates: InputRates,
-    },
-}
-
-/// Time derivatives of a wheelset's external inputs: the wheel heights follow
-/// `z(t) = z + z' tau + z'' tau^2 / 2` and the axle angle `gamma(t) = gamma + gamma'
-/// tau` over the communication step, `tau` from the time they were given, instead of
-/// being held (the heights) or turning at `V / R_w` (the angle).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct InputRates {
-    /// Time (s) each wheel height `[left, right]` was last given at, with or without
-    /// derivatives; it extrapolates from its value then.
-    pub z_since: [f64; 2],
-    /// `[[z' left, z' right] (m/s), [z'' left, z'' right] (m/s^2)]`.
-    pub z: [[f64; 2]; 2],
-    /// Whether derivatives of each wheel height `[left, right]` were given.
-    pub z_given: [bool; 2],
-    /// Whether the axle angle's rate was given (else it turns at `V / R_w`).
-    pub rotation_given: bool,
-    /// Time (s) the angle's rate was given at.
-    pub rotation_since: f64,
-    /// The axle angle's rate `gamma'` (rad/s).
-    pub rotation: f64,
-}
-
-impl InputRates {
-    /// Values in a state vector.
-    pub(super) const LEN: usize = 11;
-
-    /// Whether the wheel heights move between inputs.
-    #[inline(always)]
-    pub fn moves(&self) -> bool {
-        self.z_given[0] || self.z_given[1]
-    }
-
-    /// The wheel heights (m) at time `t` (s) from `z` given at [`InputRates::z_since`].
-    #[inline]
-    pub(super) fn wheel_z_at(&self, z: [f64; 2], t: f64) -> [f64; 2] {
-        [0, 1].map(|i| {
-            let tau = t - self.z_since[i];
-            z[i] + tau * (self.z[0][i] + 0.5 * tau * self.z[1][i])
-        })
-    }
-
-    pub(super) fn to_array(self) -> [f64; Self::LEN] {
-        let [[a, b], [c, d]] = self.z;
-        let flag = |x: bool| f64::from(u8::from(x));
-        [
-            self.z_since[0],
-            self.z_since[1],
-            a,
-            b,
-            c,
-            d,
-            flag(self.z_given[0]),
-            flag(self.z_given[1]),
-            flag(self.rotation_given),
-            self.rotation_since,
-            self.rotation,
-        ]
-    }
-
-    pub(super) fn from_slice(v: &[f64]) -> InputRates {
-        InputRates {
-            z_since: [v[0], v[1]],
-            z: [[v[2], v[3]], [v[4], v[5]]],
-            z_given: [v[6] != 0.0, v[7] != 0.0],
-            rotation_given: v[8] != 0.0,
-            rotation_since: v[9],
-            rotation: v[10],
-        }
-    }
-}
-
-impl VehicleState {
-    /// Wheel-centre displacements `[left, right]` (m); `None` for constant loads (the
-    /// wheels then ride on the rail).
-    #[inline(always)]
-    pub(super) fn wheel_z(&self) -> Option<[f64; 2]> {
-        match self {
-            VehicleState::RollPlane(v) => Some(v.wheel_z()),
-            VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
-            VehicleState::ConstantLoad(_) => None,
-            VehicleState::External { wheel_z, .. } | VehicleState::OnBogie { wheel_z } => {
-                Some(*wheel_z)
-            }
-            VehicleState::AxleBox(link) => Some(link.body().wheel_z()),
-        }
-    }
-
-    /// Advances the vehicle one step under the contact forces `p` `[left, right]` (N).
-    #[inline(always)]
-    fn step(&mut self, p: [f64; 2]) {
-        match self {
-            VehicleState::RollPlane(v) => v.step(p),
-            VehicleState::LumpedWheels(v) => v.step(p),
-            VehicleState::AxleBox(link) => link.step(p),
-            VehicleState::ConstantLoad(_)
-            | VehicleState::External { .. }
-            | VehicleState::OnBogie { .. } => {}
-        }
-    }
 }
 
 /// A running coupled simulation: the track-carrying co-simulation unit, on the fixed

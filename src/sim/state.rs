@@ -3,9 +3,11 @@
 
 use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;
+use super::inputs::InputRates;
 use super::motion::Motion;
-use super::simulation::{InputRates, Simulation, TrackState, VehicleState};
+use super::simulation::{Simulation, TrackState};
 use super::sites::Site;
+use super::vehicle_state::VehicleState;
 use crate::error::{Error, Result, num, out_of_range};
 use crate::limits::MIN_DT_FRACTION;
 

@@ -2,7 +2,8 @@
 //! solved directly (the thesis starts the track at rest and waits about 0.2 s), and a
 //! contact or track too soft to carry the static wheel load is refused.
 
-use super::simulation::{Simulation, TrackState, VehicleState};
+use super::simulation::{Simulation, TrackState};
+use super::vehicle_state::VehicleState;
 use super::wheelset::wheel_loads;
 use crate::contact::{ContactLaw, ContactModel, kw_from_hertz};
 use crate::error::{Result, non_negative, num, out_of_range};

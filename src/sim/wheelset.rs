@@ -3,7 +3,7 @@
 
 use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;
-use super::simulation::VehicleState;
+use super::vehicle_state::VehicleState;
 use crate::contact::{ContactLaw, ContactState};
 use crate::error::{Result, non_negative};
 use crate::track::PointLoad;
