@@ -17,6 +17,7 @@ mod state;
 mod static_start;
 #[cfg(test)]
 mod tests;
+mod unit_state;
 mod vehicle_state;
 mod vehicle_unit;
 mod wheelset;

@@ -10,10 +10,8 @@
 
 use super::accelerations::Accelerations;
 use super::clock::{Clock, ForceExtremes, StepPlan, Stepping};
-use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{
-    MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, MIN_STEP_FRACTION, check, within,
-};
+use crate::error::{Result, finite, non_negative, num, out_of_range, positive};
+use crate::limits::{MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, check};
 use crate::vehicle::{
     CONTACT_STIFFNESS, ExchangeLimits, HalfCarBogie, HalfCarParams, HalfCarVector, Quad,
     RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungHalfCar,
@@ -52,7 +50,7 @@ pub struct VehicleUnitParams {
 
 /// What a [`VehicleUnit`] steps.
 #[derive(Debug, Clone)]
-enum Body {
+pub(super) enum Body {
     /// The roll-plane vehicle, the contact forces in.
     RollPlane(Box<RollPlaneVehicle>),
     /// The roll-plane vehicle above its primary suspension, the primary forces in;
@@ -77,35 +75,35 @@ enum Body {
 /// ([`VehicleUnit::plan_to`], [`VehicleUnit::advance`]).
 #[derive(Debug, Clone)]
 pub struct VehicleUnit {
-    params: VehicleUnitParams,
-    body: Body,
+    pub(super) params: VehicleUnitParams,
+    pub(super) body: Body,
     /// Equal substeps of at most the base step; steps shorter than
-    /// [`MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
+    /// [`crate::limits::MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
     /// vehicle's.
-    clock: Clock,
+    pub(super) clock: Clock,
     /// The held forces of each wheelset (N); the second is unused by the roll-plane
     /// vehicle.
-    force: Quad,
+    pub(super) force: Quad,
     /// The forces that hold the vehicle at rest (N): contact forces, or primary forces
     /// with the axle-box interface.
-    rest: Quad,
-    extremes: [ForceExtremes; 2],
+    pub(super) rest: Quad,
+    pub(super) extremes: [ForceExtremes; 2],
     /// The wheels' accelerations of each wheelset (the rail signals unused).
-    accelerations: [Accelerations; 2],
+    pub(super) accelerations: [Accelerations; 2],
     /// The axle rotation (rad) at `since` (s), from which it turns at the speed held
     /// since ([`VehicleUnit::set_speed`]).
-    rotation_ref: f64,
-    since: f64,
+    pub(super) rotation_ref: f64,
+    pub(super) since: f64,
     /// With the axle-box interface: the largest stable communication steps of the
     /// exchange, estimated at the start ([`ExchangeLimits`]).
-    exchange: Option<ExchangeLimits>,
+    pub(super) exchange: Option<ExchangeLimits>,
 }
 
 impl VehicleUnit {
     /// Builds the vehicle at rest on the static wheel displacements, carrying the static
     /// wheel load on each wheel.
     ///
-    /// Errors: a parameter outside its physical range ([`Error::Parameter`], naming
+    /// Errors: a parameter outside its physical range ([`crate::Error::Parameter`], naming
     /// it); a step outside [`MIN_DT_FRACTION`] of the critical step of the fastest
     /// suspension mode up to half of it; a static state beyond the health bounds.
     pub fn new(p: &VehicleUnitParams) -> Result<Self> {
@@ -471,54 +469,11 @@ impl VehicleUnit {
         Ok(())
     }
 
-    /// The FMU name of wheelset `k`'s held force on `side`.
-    fn force_name(&self, k: usize, side: &str) -> String {
-        let kind = if self.is_axle_box() {
-            "axle_box"
-        } else {
-            "contact"
-        };
-        let prefix = if k == 0 {
-            String::new()
-        } else {
-            format!("wheelset[{}].", k + 1)
-        };
-        format!("{prefix}{kind}.{side}.force")
-    }
-
-    /// Refuses held forces beyond [`crate::limits::force_limit`] of the static loads (20
-    /// times the larger, at least 2 MN), which no physical run reaches.
-    fn check_held_forces(&self) -> Result<()> {
-        let lim = crate::limits::force_limit(self.static_load());
-        for k in 0..self.wheelsets() {
-            for (s, side) in ["left", "right"].into_iter().enumerate() {
-                let x = self.force[k][s];
-                if !within(x, lim) {
-                    let name = self.force_name(k, side);
-                    return Err(Error::Input {
-                        value: x,
-                        allowed: format!(
-                            "|{name}| <= {} N ({} times the static wheel load, at least {} N), \
-                             which no physical run exceeds; the step was not taken: likely the \
-                             partner diverged",
-                            num(lim),
-                            crate::limits::FORCE_LIMIT_FACTOR,
-                            num(crate::limits::FORCE_LIMIT_FACTOR
-                                * crate::limits::FORCE_LIMIT_MIN_STATIC_LOAD)
-                        ),
-                        name,
-                    });
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// Number of steps a communication step `h` (s) takes, with the time carried over
     /// from earlier calls: `ceil((h + carried) / dt_base)`, first reduced by `tolerance`
     /// (s), the rounding of the master's clock, so a step that is a whole multiple of the
     /// base step up to that rounding takes exactly that many steps; 0 when the sum is
-    /// below [`MIN_STEP_FRACTION`] of the base step.
+    /// below [`crate::limits::MIN_STEP_FRACTION`] of the base step.
     pub fn steps_for(&self, h: f64, tolerance: f64) -> f64 {
         self.clock.substeps(h, tolerance).n
     }
@@ -528,14 +483,14 @@ impl VehicleUnit {
     /// in use to within `tolerance` (s), they are taken as they are; otherwise the step
     /// changes to `(h + carried) / n`: first-order accurate at the change and stable for
     /// any sequence of changes, since every step stays below half the critical step. A
-    /// step (with what was carried) shorter than [`MIN_STEP_FRACTION`] of the base step
+    /// step (with what was carried) shorter than [`crate::limits::MIN_STEP_FRACTION`] of the base step
     /// is carried over to the next call instead: a step that short would round the
     /// velocities away (ratios of consecutive steps of 5,000 let the vehicle sink
     /// millimetres over minutes), so the model time lags the master's by at most that.
     ///
     /// Errors: `h` not positive; a vehicle displacement beyond
     /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`] or a wheel beyond
-    /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`Error::Diverged`]).
+    /// [`crate::limits::DISPLACEMENT_LIMIT`] ([`crate::Error::Diverged`]).
     pub fn advance(&mut self, h: f64, tolerance: f64) -> Result<()> {
         positive("communication step", h, "s")?;
         self.check_held_forces()?;
@@ -613,188 +568,5 @@ impl VehicleUnit {
         } else {
             Ok(())
         }
-    }
-
-    /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
-    pub fn check_states(&self) -> Result<()> {
-        let bad = match &self.body {
-            Body::RollPlane(v) => v.beyond_bounds(),
-            Body::Sprung { bogie, .. } => bogie.beyond_bounds(),
-            Body::HalfCar(b) => b.beyond_bounds(),
-            Body::SprungHalfCar(b) => b.beyond_bounds(),
-        };
-        match bad {
-            None => Ok(()),
-            Some((what, value, limit)) => Err(Error::Diverged {
-                what: what.into(),
-                value,
-                limit,
-                time: self.time(),
-                cause: format!(
-                    "likely forces that do not carry the vehicle (held {}: {} against a \
-                     static load of {} N per wheel){}",
-                    if self.is_axle_box() {
-                        "axle_box.*.force"
-                    } else {
-                        "contact.*.force"
-                    },
-                    (0..self.wheelsets())
-                        .map(|k| {
-                            let prefix = if k == 0 {
-                                String::new()
-                            } else {
-                                format!("wheelset[{}].", k + 1)
-                            };
-                            format!(
-                                "{prefix}left {} N, {prefix}right {} N",
-                                num(self.force[k][0]),
-                                num(self.force[k][1])
-                            )
-                        })
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    num(self.static_load()[0]),
-                    match self.exchange {
-                        Some(e) => format!(
-                            "; with the axle-box interface, communication steps above about \
-                             {} s under a Jacobi master and {} s under a sequential one (the \
-                             primary springs and dampers exchanged explicitly against the side \
-                             frames' inertia) are unstable",
-                            num(e.jacobi),
-                            num(e.sequential)
-                        ),
-                        None => String::new(),
-                    }
-                ),
-            }),
-        }
-    }
-
-    /// The body's state vector.
-    fn body_state(&self) -> Vec<f64> {
-        match &self.body {
-            Body::RollPlane(v) => v.state_vector(),
-            Body::Sprung { bogie, .. } => bogie.state_vector(),
-            Body::HalfCar(b) => b.state_vector(),
-            Body::SprungHalfCar(b) => b.state_vector(),
-        }
-    }
-
-    /// Values ahead of the body's in a state vector: the clock (3), the motion (speed,
-    /// rotation at the last change of speed, its time), then per wheelset the held
-    /// forces (2) and the extremes.
-    fn head_len(&self) -> usize {
-        6 + self.wheelsets() * (2 + ForceExtremes::LEN + Accelerations::LEN)
-    }
-
-    /// Everything that determines the continuation: the clock (`t0` (s), `k`, the
-    /// carried time (s)), the motion (the speed (m/s), the rotation (rad) at its last
-    /// change and that time (s)), the held forces `[left, right]` (N) of each wheelset, the
-    /// largest and smallest forces `[left, right]` (N) of each, the wheels'
-    /// accelerations' history and extremes of each ([`Accelerations`]), then the
-    /// vehicle's step and displacements; [`VehicleUnit::set_state_vector`] restores it exactly.
-    pub fn state_vector(&self) -> Vec<f64> {
-        let c = &self.clock;
-        let n = self.wheelsets();
-        let mut v = vec![
-            c.t0,
-            c.k as f64,
-            c.carried,
-            self.params.speed,
-            self.rotation_ref,
-            self.since,
-        ];
-        v.extend(self.force[..n].iter().flatten());
-        for e in &self.extremes[..n] {
-            v.extend(e.to_array());
-        }
-        for a in &self.accelerations[..n] {
-            v.extend(a.to_array());
-        }
-        v.extend(self.body_state());
-        v
-    }
-
-    /// Restores a state written by [`VehicleUnit::state_vector`] of a unit with the
-    /// same parameters. Refused: a wrong length, a clock that is not finite from 0 on, a
-    /// step count that is not a whole number below 2^53, a carried time not below the
-    /// least step, a force beyond 1e7 N, a step outside
-    /// [`MIN_STEP_FRACTION`]` dt_base ..= dt_base`, and a state beyond the health bounds
-    /// ([`VehicleUnit::check_states`]).
-    pub fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let head = self.head_len();
-        let len = head + self.body_state().len();
-        if v.len() != len {
-            return Err(out_of_range(
-                "vehicle unit state length",
-                v.len() as f64,
-                format!("{len} values"),
-            ));
-        }
-        let count = crate::limits::is_count;
-        let min_step = MIN_STEP_FRACTION * self.clock.base;
-        if !(v[0].is_finite() && v[0] >= 0.0 && count(v[1]) && v[2] >= 0.0 && v[2] < min_step) {
-            return Err(out_of_range(
-                "state: clock",
-                v[0],
-                "t0 finite and >= 0 s, step count a whole number in [0, 2^53), carried time \
-                 below the least step",
-            ));
-        }
-        if check("speed", v[3]).is_err() || !v[4].is_finite() || !(v[5].is_finite() && v[5] >= 0.0)
-        {
-            return Err(out_of_range(
-                "state: motion",
-                v[3],
-                "a speed in its range, a finite rotation, a time of change >= 0 s",
-            ));
-        }
-        // The held forces and their extremes (the accelerations after them are checked
-        // where they are read).
-        let forces_end = 6 + self.wheelsets() * (2 + ForceExtremes::LEN);
-        for &f in &v[6..forces_end] {
-            if !within(f, 1e7) {
-                return Err(out_of_range("state: contact force", f, "|F| <= 1e7 N"));
-            }
-        }
-        let dt = v[head];
-        if !(dt >= min_step && dt <= self.clock.base) {
-            return Err(out_of_range(
-                "state: step",
-                dt,
-                format!("{} s <= dt <= {} s", num(min_step), num(self.clock.base)),
-            ));
-        }
-        let body = &v[head..];
-        match &mut self.body {
-            Body::RollPlane(v) => v.set_state_vector(body)?,
-            Body::Sprung { bogie, .. } => bogie.set_state_vector(body)?,
-            Body::HalfCar(b) => b.set_state_vector(body)?,
-            Body::SprungHalfCar(b) => b.set_state_vector(body)?,
-        }
-        self.clock.dt = dt;
-        self.clock.t0 = v[0];
-        self.clock.k = v[1] as u64;
-        self.clock.carried = v[2];
-        self.params.speed = v[3];
-        self.rotation_ref = v[4];
-        self.since = v[5];
-        let n = self.wheelsets();
-        for k in 0..n {
-            self.force[k] = [v[6 + 2 * k], v[7 + 2 * k]];
-            let e = 6 + 2 * n + ForceExtremes::LEN * k;
-            self.extremes[k] = ForceExtremes::from_slice(&v[e..e + ForceExtremes::LEN]);
-            let a = 6 + n * (2 + ForceExtremes::LEN) + Accelerations::LEN * k;
-            let a = &v[a..a + Accelerations::LEN];
-            if let Some(&bad) = a.iter().find(|x| !x.is_finite()) {
-                return Err(out_of_range(
-                    "vehicle unit state: accelerations",
-                    bad,
-                    "finite",
-                ));
-            }
-            self.accelerations[k] = Accelerations::from_slice(a);
-        }
-        self.check_states()
     }
 }
