@@ -26,13 +26,14 @@ mod half_car;
 mod half_car_bogie;
 mod lumped;
 mod roll_plane;
+mod sprung_bogie;
 #[cfg(test)]
 mod tests;
 mod wagon;
 #[cfg(test)]
 mod wagon_tests;
 
-pub use axle_box::{PrimaryLink, SideFrameInertia, SprungBogie, WheelsetBody};
+pub use axle_box::{PrimaryLink, SideFrameInertia, WheelsetBody};
 pub use exchange::{CONTACT_STIFFNESS, ExchangeLimits};
 pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
@@ -40,4 +41,5 @@ pub use half_car::{
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
+pub use sprung_bogie::SprungBogie;
 pub use wagon::{Octet, WAGON_DOFS, Wagon, WagonMatrix, WagonParams, WagonVector, bogie_start};
