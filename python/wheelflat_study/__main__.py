@@ -21,6 +21,19 @@ from .spec import load_study
 
 
 def main(argv=None):
+    """The study command; returns its exit status."""
+    try:
+        return _main(argv)
+    finally:
+        # Arrow's native threads (the tables' Parquet writers) joined while Arrow is
+        # alive: left to the interpreter's teardown they can abort the process
+        # (SIGABRT, "terminate called without an active exception", apache/arrow
+        # #34314) after the study has finished.
+        import gc
+        gc.collect()
+
+
+def _main(argv=None):
     ap = argparse.ArgumentParser(prog="wheelflat-study", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("study", nargs="?", help="the study file (TOML), e.g. studies/speed_flat.toml")
