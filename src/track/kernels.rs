@@ -110,21 +110,56 @@ pub(super) fn sleepers_body<const FMA: bool>(
     let (pl, pr) = (&mut pl[..m], &mut pr[..m]);
     for i in 0..m {
         let (z, f, zp, fp) = (zs[i], ph[i], zsp[i], php[i]);
-        // Rail over seat, now and one step back: u = Z_rail - (Z_s -/+ l_s/2 phi).
-        let (ul, ur) = (
-            rl[i] - madd::<FMA>(-c.ls, f, z),
-            rr[i] - madd::<FMA>(c.ls, f, z),
-        );
-        let (upl, upr) = (
-            rlp[i] - madd::<FMA>(-c.ls, fp, zp),
-            rrp[i] - madd::<FMA>(c.ls, fp, zp),
-        );
-        let fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
-        let fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
+        let (fl, fr) = c.pad_forces::<FMA>([rl[i], rr[i], rlp[i], rrp[i]], [z, f], [zp, fp]);
         pl[i] = fl;
         pr[i] = fr;
-        zsp[i] = madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z));
-        php[i] = madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f));
+        (zsp[i], php[i]) = c.sleeper_update::<FMA>([z, f], [zp, fp], fl, fr);
+    }
+}
+
+impl SleeperCoeffs {
+    /// The pad forces (3.9) `(left, right)` (N, up on the rails) of one sleeper: the rail
+    /// over its seats now and a step back `[left, right, left back, right back]` (m),
+    /// its bounce and roll now and a step back (m, rad).
+    #[inline(always)]
+    pub(super) fn pad_forces<const FMA: bool>(
+        &self,
+        rail: [f64; 4],
+        now: [f64; 2],
+        back: [f64; 2],
+    ) -> (f64, f64) {
+        let ([rl, rr, rlp, rrp], [z, f], [zp, fp]) = (rail, now, back);
+        // Rail over seat, now and one step back: u = Z_rail - (Z_s -/+ l_s/2 phi).
+        let (ul, ur) = (
+            rl - madd::<FMA>(-self.ls, f, z),
+            rr - madd::<FMA>(self.ls, f, z),
+        );
+        let (upl, upr) = (
+            rlp - madd::<FMA>(-self.ls, fp, zp),
+            rrp - madd::<FMA>(self.ls, fp, zp),
+        );
+        (
+            madd::<FMA>(-self.kpc, ul, self.cp * upl),
+            madd::<FMA>(-self.kpc, ur, self.cp * upr),
+        )
+    }
+
+    /// The sleeper's bounce and roll a step on (3.18) from now and a step back (m,
+    /// rad) under the pad forces `fl`, `fr` (N, up on the rails), both ballast seats
+    /// carrying.
+    #[inline(always)]
+    pub(super) fn sleeper_update<const FMA: bool>(
+        &self,
+        now: [f64; 2],
+        back: [f64; 2],
+        fl: f64,
+        fr: f64,
+    ) -> (f64, f64) {
+        let ([z, f], [zp, fp]) = (now, back);
+        (
+            madd::<FMA>(-self.zf, fl + fr, madd::<FMA>(self.zzp, zp, self.zz * z)),
+            madd::<FMA>(self.pf, fl - fr, madd::<FMA>(self.ppp, fp, self.pp * f)),
+        )
     }
 }
 

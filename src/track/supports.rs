@@ -362,16 +362,9 @@ fn sleeper_with_limits<const FMA: bool>(
     c: &SleeperCoeffs,
     u: &Unilateral,
 ) -> [bool; 4] {
-    let [rl, rr, rlp, rrp] = rail;
     let [z, f] = now;
     let [zp, fp] = back;
-    let (ul, ur) = (rl - madd::<FMA>(-c.ls, f, z), rr - madd::<FMA>(c.ls, f, z));
-    let (upl, upr) = (
-        rlp - madd::<FMA>(-c.ls, fp, zp),
-        rrp - madd::<FMA>(c.ls, fp, zp),
-    );
-    let mut fl = madd::<FMA>(-c.kpc, ul, c.cp * upl);
-    let mut fr = madd::<FMA>(-c.kpc, ur, c.cp * upr);
+    let (mut fl, mut fr) = c.pad_forces::<FMA>(rail, now, back);
     let lim = u.pad_limit;
     let (lifted_l, lifted_r) = (fl < -lim, fr < -lim);
     if lifted_l {
@@ -385,10 +378,7 @@ fn sleeper_with_limits<const FMA: bool>(
     let (g, lim) = (u.gap[i], u.ballast_limit[i]);
     let mut on = [true, true];
     let (mut zn, mut pn) = if g == 0.0 {
-        (
-            madd::<FMA>(-c.zf, fl + fr, madd::<FMA>(c.zzp, zp, c.zz * z)),
-            madd::<FMA>(c.pf, fl - fr, madd::<FMA>(c.ppp, fp, c.pp * f)),
-        )
+        c.sleeper_update::<FMA>(now, back, fl, fr)
     } else {
         u.solve(z, f, zp, fp, fl, fr, g, lim, on)
     };
