@@ -7,6 +7,7 @@
 mod banded;
 mod central_difference;
 mod harmonic;
+mod modes;
 mod quadrature;
 mod roots;
 mod simd;
@@ -16,6 +17,7 @@ mod table;
 pub(crate) use banded::solve_banded_spd;
 pub(crate) use central_difference::{CentralDifference, check_critical_step};
 pub use harmonic::harmonic_amplitude;
+pub use modes::natural_frequencies;
 pub(crate) use quadrature::gauss_legendre;
 pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};

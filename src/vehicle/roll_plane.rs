@@ -152,15 +152,7 @@ impl RollPlaneParams {
     /// Undamped natural angular frequencies (rad/s), ascending: the square roots of
     /// the eigenvalues of `M^-1 K`, from the symmetric form `M^-1/2 K M^-1/2`.
     pub fn natural_frequencies(&self) -> [f64; 6] {
-        let s = self.mass_diagonal().map(|m| 1.0 / m.sqrt());
-        let a = Matrix6::from_diagonal(&s) * self.stiffness_matrix() * Matrix6::from_diagonal(&s);
-        let mut w: Vec<f64> = a
-            .symmetric_eigenvalues()
-            .iter()
-            .map(|l| l.max(0.0).sqrt())
-            .collect();
-        w.sort_by(f64::total_cmp);
-        [w[0], w[1], w[2], w[3], w[4], w[5]]
+        crate::numerics::natural_frequencies(&self.mass_diagonal(), &self.stiffness_matrix())
     }
 
     /// Critical step of the undamped central-difference scheme, `2 / omega_max` (s).

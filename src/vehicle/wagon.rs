@@ -240,16 +240,7 @@ impl WagonParams {
     /// Undamped natural frequencies (rad/s), ascending: the square roots of the
     /// eigenvalues of `M^-1 K` (through the symmetric `M^-1/2 K M^-1/2`).
     pub fn natural_frequencies(&self) -> [f64; WAGON_DOFS] {
-        let s = self.mass_diagonal().map(|m| 1.0 / m.sqrt());
-        let d = WagonMatrix::from_diagonal(&s);
-        let a = d * self.stiffness_matrix() * d;
-        let mut w: Vec<f64> = a
-            .symmetric_eigenvalues()
-            .iter()
-            .map(|l| l.max(0.0).sqrt())
-            .collect();
-        w.sort_by(f64::total_cmp);
-        std::array::from_fn(|i| w[i])
+        crate::numerics::natural_frequencies(&self.mass_diagonal(), &self.stiffness_matrix())
     }
 
     /// Static contact force on each of the eight wheels (N): an eighth of the weight.
