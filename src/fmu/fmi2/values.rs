@@ -298,16 +298,7 @@ impl<M: Model> Instance<M> {
         self.check(call)?;
         let name = call.name();
         for (&r, v) in vrs.iter().zip(vals) {
-            let s = self.spec(name, r)?;
-            if s.ty != VarType::String {
-                return self.refuse(
-                    Status::Error,
-                    format!(
-                        "{name}: variable `{}` (value reference {}) is not of type String",
-                        s.name, s.vr
-                    ),
-                );
-            }
+            let s = self.string_spec(name, r)?;
             if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
                 return self.refuse(
                     Status::Error,
@@ -337,6 +328,21 @@ impl<M: Model> Instance<M> {
         Ok(())
     }
 
+    /// The spec of String variable `r`; another type is refused.
+    fn string_spec(&mut self, call: &str, r: u32) -> FmiResult<&'static VarSpec> {
+        let s = self.spec(call, r)?;
+        if s.ty != VarType::String {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: variable `{}` (value reference {}) is not of type String",
+                    s.name, s.vr
+                ),
+            );
+        }
+        Ok(s)
+    }
+
     /// `fmi2GetString`: the String parameters' values.
     pub fn get_string(&mut self, vrs: &[u32]) -> FmiResult<Vec<String>> {
         let call = Call::GetString;
@@ -344,16 +350,7 @@ impl<M: Model> Instance<M> {
         let name = call.name();
         let mut out = Vec::with_capacity(vrs.len());
         for &r in vrs {
-            let s = self.spec(name, r)?;
-            if s.ty != VarType::String {
-                return self.refuse(
-                    Status::Error,
-                    format!(
-                        "{name}: variable `{}` (value reference {}) is not of type String",
-                        s.name, s.vr
-                    ),
-                );
-            }
+            self.string_spec(name, r)?;
             out.push(self.strings[r as usize].clone());
         }
         Ok(out)
