@@ -84,14 +84,14 @@ impl Site {
     }
 
     /// What `track`, whose node 0 lies at `origin` (m), feels at `x` (m, line
-    /// coordinates) now; zeros (the track at rest) outside the track: an endless
+    /// coordinates) now; `None` outside the track (the track at rest there): an endless
     /// track's window has not reached the site yet, or has left it behind.
-    fn read(track: &Track, origin: f64, x: f64) -> SiteValues {
+    fn read(track: &Track, origin: f64, x: f64) -> Option<SiteValues> {
         if !Self::on_track(track, origin, x) {
-            return [[0.0; NQ]; 2];
+            return None;
         }
         let x = x - origin;
-        [0, 1].map(|rail| {
+        Some([0, 1].map(|rail| {
             let r = track.rail_response(rail, x);
             let s = track.support_response(rail, x);
             [
@@ -106,10 +106,10 @@ impl Site {
                 0.0,
                 0.0,
             ]
-        })
+        }))
     }
 
-    /// The accelerations of [`MOVING`] in `now` from the history, step `dt` (s). Off
+    /// The accelerations of [`MOVING`] in `now` from the history and its steps. Off
     /// an endless track's window the site reads the track at rest: no acceleration,
     /// and a history at rest, as the track that enters the window is.
     fn accelerate(&mut self, on_track: bool) {
@@ -137,6 +137,13 @@ impl Site {
         }
     }
 
+    /// Reads what the track feels at the site now, with the accelerations.
+    fn read_now(&mut self, track: &Track, origin: f64) {
+        let values = Self::read(track, origin, self.position);
+        self.now = values.unwrap_or([[0.0; NQ]; 2]);
+        self.accelerate(values.is_some());
+    }
+
     /// Reads the track now and takes the values into the extremes.
     pub(crate) fn record(&mut self, track: &Track, origin: f64) {
         for rail in 0..2 {
@@ -145,8 +152,7 @@ impl Site {
             }
         }
         self.steps = [track.dt(), self.steps[0]];
-        self.now = Self::read(track, origin, self.position);
-        self.accelerate(Self::on_track(track, origin, self.position));
+        self.read_now(track, origin);
         for rail in 0..2 {
             for q in 0..NQ {
                 let x = self.now[rail][q];
@@ -189,8 +195,7 @@ impl Site {
         for (slot, &x) in slots.zip(v) {
             *slot = x;
         }
-        self.now = Self::read(track, origin, self.position);
-        self.accelerate(Self::on_track(track, origin, self.position));
+        self.read_now(track, origin);
     }
 }
 
@@ -230,7 +235,7 @@ pub(crate) fn sites(
                     ),
                 ));
             }
-            let now = Site::read(track, origin, x);
+            let now = Site::read(track, origin, x).unwrap_or([[0.0; NQ]; 2]);
             // At rest before the start: the history holds the static state.
             let at_rest = |rail: usize| MOVING.map(|q| [now[rail][q]; 2]);
             Ok(Site {

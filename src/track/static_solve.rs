@@ -273,6 +273,7 @@ impl Track {
         // A support lets go beyond its limit by more than this (N): one that sits at
         // it (a hanging sleeper's pads with no preload) keeps carrying.
         let tol = 1e-6;
+        let order = self.static_order_along_track();
         for _ in 0..MAX_PASSES {
             let mut rhs = f.to_vec();
             for i in 0..ns {
@@ -296,7 +297,6 @@ impl Track {
                     rhs[iph + i] += arm * load;
                 }
             }
-            let order = self.static_order_along_track();
             let on = (pad_on.as_slice(), ballast_on.as_slice());
             let x = solve_banded_spd(
                 &order,
