@@ -6,11 +6,12 @@ use crate::table::Table;
 use std::fmt::Write as _;
 
 /// The FMUs in the order of the document's columns.
-const COLUMNS: [&str; 4] = [
+const COLUMNS: [&str; 5] = [
     "TrackContact",
     "RollPlaneVehicle",
     "CoupledSystem",
     "HalfCarBogie",
+    "Wagon",
 ];
 
 /// Short name of a causality in the document.
@@ -34,6 +35,7 @@ pub fn write(table: &Table) -> String {
          table, `cargo run --release --bin build_fmus -- fmu docs/VARIABLES.md` rewrites this\n\
          file, and a unit test fails while it is stale.\n\n\
          Columns: T = TrackContact, V = RollPlaneVehicle, C = CoupledSystem, H = HalfCarBogie,\n\
+         W = Wagon,\n\
          with the variable's\n\
          causality in each (par = parameter, calc = calculated parameter, in = input, out =\n\
          output). The start value and description are those of the first FMU (in column order)\n\
@@ -41,8 +43,8 @@ pub fn write(table: &Table) -> String {
          the display unit is what tools may show. The range is what\n\
          `fmi2SetReal`/`fmi2SetInteger` accept (the physical ranges of `src/limits.rs`); the\n\
          engine checks the rest at `fmi2ExitInitializationMode`.\n\n\
-         | name | T | V | C | H | type | unit (display) | start | range | description |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+         | name | T | V | C | H | W | type | unit (display) | start | range | description |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let fmus: Vec<_> = COLUMNS
         .iter()

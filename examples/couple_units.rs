@@ -7,7 +7,9 @@
 //!
 //! `cargo run --release --example couple_units [steps_per_exchange]`
 
-use wheelflat::sim::{Scenario, Simulation, VehicleSpec, VehicleUnit, VehicleUnitParams};
+use wheelflat::sim::{
+    Scenario, Simulation, UnitModel, VehicleSpec, VehicleUnit, VehicleUnitParams,
+};
 
 fn main() -> Result<(), wheelflat::Error> {
     let per_exchange: u64 = std::env::args()
@@ -33,8 +35,8 @@ fn main() -> Result<(), wheelflat::Error> {
         dt: 0.0,
         static_wheel_z: track.wheel_z(),
         axle_box: false,
-        half_car: None,
-        trailing_static_wheel_z: [0.0; 2],
+        model: UnitModel::RollPlane,
+        trailing_static_wheel_z: [[0.0; 2]; 3],
     })?;
     let h = per_exchange as f64 * track.dt();
     let revolution = std::f64::consts::TAU * scenario.wheel_radius / scenario.speed;

@@ -78,8 +78,8 @@ fn a_restored_half_car_state_continues_bit_for_bit() {
         .run(0.05, |s| second.push(s.contact[0].force))
         .unwrap();
     assert_eq!(first, second);
-    let b = sim.bogie().unwrap().displacements();
-    assert_eq!(b, again.bogie().unwrap().displacements());
+    let b = sim.carrier().unwrap().displacements();
+    assert_eq!(b, again.carrier().unwrap().displacements());
 }
 
 #[test]

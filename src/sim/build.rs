@@ -15,7 +15,9 @@ use crate::error::{Error, Result, finite, non_negative, num, out_of_range, posit
 use crate::limits::{MAX_WHEELSETS, MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
-use crate::vehicle::{HalfCarBogie, LumpedTrack, LumpedWheels, RollPlaneVehicle};
+use crate::vehicle::{
+    HalfCarBogie, LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle, Wagon,
+};
 use crate::wheel::WheelProfile;
 
 /// The contact stiffness passed to the track's stability limit is this many times the
@@ -159,6 +161,20 @@ impl Simulation {
                 )
             })?;
         }
+        if let VehicleSpec::Wagon(p) = &s.vehicle {
+            p.validate().map_err(|e| {
+                e.renamed(
+                    "vehicle.wheelbase",
+                    "wheelset[2].offset",
+                    "(the wagon's bogies' wheelbase)",
+                )
+                .renamed(
+                    "vehicle.bogie_distance",
+                    "wheelset[3].offset",
+                    "(the wagon's bogie centre distance)",
+                )
+            })?;
+        }
         positive("wheel.radius", s.wheel_radius, "m")?;
         finite("speed", s.speed, "m/s")?;
         if s.speed < 0.0 {
@@ -240,7 +256,9 @@ impl Simulation {
                 VehicleSpec::AxleBox { vehicle, .. } => VehicleState::AxleBox(
                     crate::vehicle::PrimaryLink::new(vehicle, dt, frame_inertia)?,
                 ),
-                VehicleSpec::HalfCar(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
+                VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
+                    VehicleState::OnBogie { wheel_z: [0.0; 2] }
+                }
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
@@ -264,10 +282,7 @@ impl Simulation {
             })
             .collect::<Result<Vec<_>>>()?;
         let wheelsets = Wheelsets::new(lead, trailing);
-        let bogie = match &s.vehicle {
-            VehicleSpec::HalfCar(p) => Some(Box::new(half_car_on(p, s, dt)?)),
-            _ => None,
-        };
+        let carrier = carrier_on(s, dt)?;
         let origin = window.map_or(0.0, |w: Window| w.origin());
         let track = match &track_spec {
             TrackSpec::Discrete(p) => {
@@ -328,7 +343,7 @@ impl Simulation {
             force_limit: force_limit(static_load),
             simd: SimdLevel::detect(),
             sites: Vec::new(),
-            bogie,
+            carrier,
             shared_side_frames,
             voids: s.voids,
             irregular: s.rails.iter().any(RailProfile::is_some)
@@ -376,27 +391,48 @@ impl Simulation {
     }
 }
 
-/// The half-car bogie of `p` for the scenario `s`, stepped with `dt` (s): it needs
-/// exactly two wheelsets, the trailing one at the bogie's wheelbase.
+/// The vehicle on several wheelsets of the scenario `s`, stepped with `dt` (s): the
+/// half-car bogie on exactly two wheelsets, the trailing one at its wheelbase; the
+/// wagon on exactly four, at its wheelbase `a` and bogie centre distance `d` (offsets
+/// `a`, `d`, `d + a`). `None` for a vehicle on each wheelset.
 ///
-/// Errors: another number of wheelsets (named `wheelsets`), a trailing offset other
-/// than the wheelbase (named `wheelset[2].offset`), the bogie's own refusals
-/// ([`HalfCarBogie::new`]).
-fn half_car_on(p: &crate::vehicle::HalfCarParams, s: &Scenario, dt: f64) -> Result<HalfCarBogie> {
-    if s.trailing.len() != 1 {
+/// Errors: another number of wheelsets (named `wheelsets`), an offset other than the
+/// vehicle's (named `wheelset[k].offset`), the vehicle's own refusals
+/// ([`HalfCarBogie::new`], [`Wagon::new`]).
+fn carrier_on(s: &Scenario, dt: f64) -> Result<Option<Box<dyn RailVehicle>>> {
+    let (offsets, what): (Vec<f64>, &str) = match &s.vehicle {
+        VehicleSpec::HalfCar(p) => (
+            vec![p.wheelbase],
+            "the half-car bogie (vehicle.model = half_car): its two wheelsets",
+        ),
+        VehicleSpec::Wagon(p) => {
+            let (a, d) = (p.bogie.wheelbase, p.bogie_distance);
+            (
+                vec![a, d, d + a],
+                "the wagon (vehicle.model = wagon): its two bogies' wheelsets",
+            )
+        }
+        _ => return Ok(None),
+    };
+    if s.trailing.len() != offsets.len() {
         return Err(out_of_range(
             "wheelsets",
             (s.trailing.len() + 1) as f64,
-            "2 with the half-car bogie (vehicle.model = half_car): its two wheelsets",
+            format!("{} with {what}", offsets.len() + 1),
         ));
     }
-    let offset = s.trailing[0].offset;
-    if (offset - p.wheelbase).abs() > 1e-9 * p.wheelbase {
-        return Err(out_of_range(
-            "wheelset[2].offset",
-            offset,
-            format!("the half-car bogie's wheelbase, {} m", num(p.wheelbase)),
-        ));
+    for ((w, &x), k) in s.trailing.iter().zip(&offsets).zip(2..) {
+        if (w.offset - x).abs() > 1e-9 * x {
+            return Err(out_of_range(
+                &format!("wheelset[{k}].offset"),
+                w.offset,
+                format!("{} m, its place in {what}", num(x)),
+            ));
+        }
     }
-    HalfCarBogie::new(*p, dt)
+    Ok(Some(match &s.vehicle {
+        VehicleSpec::HalfCar(p) => Box::new(HalfCarBogie::new(*p, dt)?),
+        VehicleSpec::Wagon(p) => Box::new(Wagon::new(*p, dt)?),
+        _ => return Ok(None),
+    }))
 }

@@ -34,7 +34,7 @@ impl Simulation {
                 VehicleState::AxleBox(link) => link.body().beyond_bounds(),
                 _ => None,
             };
-            let beyond = beyond.or_else(|| match (&self.bogie, k) {
+            let beyond = beyond.or_else(|| match (&self.carrier, k) {
                 (Some(b), 0) => b.beyond_bounds(),
                 _ => None,
             });

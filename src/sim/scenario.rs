@@ -13,7 +13,7 @@ use crate::contact::ContactModel;
 use crate::track::RailProfile;
 use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
 use crate::vehicle::{
-    HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
+    HalfCarParams, LumpedTrackParams, WagonParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
 };
 use crate::wheel::{FlatSpec, OutOfRoundness};
 use std::sync::Arc;
@@ -36,6 +36,10 @@ pub enum VehicleSpec {
     /// two wheelsets: the leading one and one trailing wheelset at the bogie's
     /// wheelbase ([`Scenario::trailing`]).
     HalfCar(HalfCarParams),
+    /// The four-axle wagon ([`crate::vehicle::Wagon`]): the car body on two half-car
+    /// bogies, on four wheelsets at the offsets `a`, `d`, `d + a` (the bogies'
+    /// wheelbase `a`, their centre distance `d`).
+    Wagon(WagonParams),
     /// The chapter-2 lumped wheel on each rail.
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).
@@ -527,7 +531,8 @@ pub enum SideFrameSpec {
     /// One side frame of `mass` (kg) and `pitch_inertia` (kg m^2) on each side over the
     /// first two wheelsets, in bounce and pitch (the half-car bogie: twice
     /// `vehicle.sideframe.mass`, `vehicle.sideframe.pitch_inertia`), its wheelbase the
-    /// second wheelset's offset. Needs exactly two wheelsets.
+    /// second wheelset's offset; with four wheelsets (the wagon) such side frames over
+    /// wheelsets 3 and 4 too, at the same wheelbase. Needs two or four wheelsets.
     HalfCar {
         /// Mass of one side frame (kg).
         mass: f64,
@@ -556,12 +561,15 @@ impl SideFrameSpec {
             } => {
                 crate::limits::check("vehicle.sideframe.mass", 0.5 * mass)?;
                 crate::limits::check("vehicle.sideframe.pitch_inertia", pitch_inertia)?;
-                if s.trailing.len() != 1 {
+                // Wheelsets 1 and 2 share side frames, and with four wheelsets (the
+                // wagon's two bogies) wheelsets 3 and 4 too, at the same wheelbase.
+                let n = s.trailing.len() + 1;
+                if n != 2 && n != 4 {
                     return Err(out_of_range(
                         "wheelsets",
-                        (s.trailing.len() + 1) as f64,
-                        "2 with vehicle.model = half_car at the axle boxes (the bogie's side \
-                         frames span wheelsets 1 and 2)",
+                        n as f64,
+                        "2 with vehicle.model = half_car or 4 with vehicle.model = wagon at the \
+                         axle boxes (the bogies' side frames span wheelsets 1 and 2, and 3 and 4)",
                     ));
                 }
                 let wheelbase = s.trailing[0].offset;
@@ -569,10 +577,25 @@ impl SideFrameSpec {
                     e.renamed(
                         "vehicle.wheelbase",
                         "wheelset[2].offset",
-                        "(the half-car bogie's wheelbase, with vehicle.model = half_car at the \
+                        "(the bogies' wheelbase, with vehicle.model = half_car or wagon at the \
                          axle boxes)",
                     )
                 })?;
+                if n == 4 {
+                    let rear = s.trailing[2].offset - s.trailing[1].offset;
+                    if (rear - wheelbase).abs() > 1e-9 * wheelbase {
+                        return Err(out_of_range(
+                            "wheelset[4].offset",
+                            s.trailing[2].offset,
+                            format!(
+                                "wheelset[3].offset + the wheelbase wheelset[2].offset = {} m \
+                                 (the rear bogie's wheelbase, with vehicle.model = wagon at the \
+                                 axle boxes)",
+                                crate::error::num(s.trailing[1].offset + wheelbase)
+                            ),
+                        ));
+                    }
+                }
                 Ok((
                     SideFrameInertia::pitching(mass, pitch_inertia, wheelbase),
                     true,

@@ -16,7 +16,7 @@ use crate::error::{Error, Result, non_negative, num};
 use crate::limits::{DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, within};
 use crate::sim::{Scenario, VoidedSleepers};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track};
-use crate::vehicle::{HalfCarBogie, LumpedTrack};
+use crate::vehicle::{Axles, LumpedTrack, RailVehicle};
 
 /// Track state of a simulation.
 // Not boxed: the variant is touched every step and there is one per simulation.
@@ -60,8 +60,9 @@ pub struct Simulation {
     pub(super) simd: SimdLevel,
     /// The observation points ([`Scenario::sites`]).
     pub(super) sites: Vec<Site>,
-    /// The half-car bogie that moves the two wheelsets ([`VehicleSpec::HalfCar`]).
-    pub(super) bogie: Option<Box<HalfCarBogie>>,
+    /// The vehicle that moves several wheelsets' wheels ([`VehicleSpec::HalfCar`],
+    /// [`VehicleSpec::Wagon`]), behind one interface.
+    pub(super) carrier: Option<Box<dyn RailVehicle>>,
     /// The first two wheelsets' axle boxes under the same side frames
     /// ([`crate::sim::SideFrameSpec::HalfCar`]).
     pub(super) shared_side_frames: bool,
@@ -401,8 +402,8 @@ impl Simulation {
         if self.shared_side_frames {
             self.share_side_frames();
         }
-        if self.bogie.is_some() {
-            self.step_bogie();
+        if self.carrier.is_some() {
+            self.step_carrier();
         }
         match &mut self.track {
             TrackState::Discrete(t) => {
@@ -461,7 +462,7 @@ impl Simulation {
                 }
             }
         }
-        if let Some(b) = &mut self.bogie {
+        if let Some(b) = &mut self.carrier {
             b.change_dt(dt)?;
         }
         self.clock.restart(dt);
@@ -469,48 +470,53 @@ impl Simulation {
         Ok(())
     }
 
-    /// The half-car bogie, when it carries the wheelsets
-    /// ([`crate::sim::VehicleSpec::HalfCar`]).
-    pub fn bogie(&self) -> Option<&HalfCarBogie> {
-        self.bogie.as_deref()
+    /// The vehicle that carries several wheelsets (the half-car bogie, the wagon),
+    /// when there is one ([`crate::sim::VehicleSpec::HalfCar`],
+    /// [`crate::sim::VehicleSpec::Wagon`]).
+    pub fn carrier(&self) -> Option<&dyn RailVehicle> {
+        self.carrier.as_deref()
     }
 
-    /// With the half-car bogie's side frames over the first two wheelsets' axle boxes
-    /// ([`crate::sim::SideFrameSpec::HalfCar`]): each wheelset's primary forces of the
-    /// step into the other's, which they move through the side frames' pitch.
+    /// With a bogie's side frames over two wheelsets' axle boxes
+    /// ([`crate::sim::SideFrameSpec::HalfCar`]: wheelsets 1 and 2, and 3 and 4 with
+    /// four): each wheelset's primary forces of the step into its partner's, which they
+    /// move through the side frames' pitch.
     #[inline(never)]
     fn share_side_frames(&mut self) {
-        let last = [0, 1].map(|k| match self.wheelsets.get(k).map(|w| &w.vehicle) {
-            Some(VehicleState::AxleBox(link)) => Some(link.last_force()),
-            _ => None,
-        });
-        if let [Some(a), Some(b)] = last {
-            for (k, f) in [(0, b), (1, a)] {
-                if let Some(VehicleState::AxleBox(link)) =
-                    self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
-                {
-                    link.set_partner_force(f);
+        for pair in [0, 2] {
+            let last = [pair, pair + 1].map(|k| match self.wheelsets.get(k).map(|w| &w.vehicle) {
+                Some(VehicleState::AxleBox(link)) => Some(link.last_force()),
+                _ => None,
+            });
+            if let [Some(a), Some(b)] = last {
+                for (k, f) in [(pair, b), (pair + 1, a)] {
+                    if let Some(VehicleState::AxleBox(link)) =
+                        self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
+                    {
+                        link.set_partner_force(f);
+                    }
                 }
             }
         }
     }
 
-    /// Advances the half-car bogie one step under the contact forces of its two
-    /// wheelsets' samples at `t_j`, then moves their wheels.
+    /// Advances the vehicle on several wheelsets one step under the contact forces of
+    /// its wheelsets' samples at `t_j`, then moves their wheels.
     #[inline(never)]
-    fn step_bogie(&mut self) {
-        let p = [0, 1].map(|k| self.wheelsets.get(k).map_or([0.0; 2], Wheelset::forces));
-        if let Some(b) = &mut self.bogie {
-            b.step(p);
+    fn step_carrier(&mut self) {
+        let p: Axles =
+            std::array::from_fn(|k| self.wheelsets.get(k).map_or([0.0; 2], Wheelset::forces));
+        if let Some(b) = &mut self.carrier {
+            b.step(&p);
         }
-        self.sync_bogie_wheels();
+        self.sync_carrier_wheels();
     }
 
-    /// The bogie's wheel displacements into its wheelsets.
-    pub(super) fn sync_bogie_wheels(&mut self) {
-        let Some(b) = &self.bogie else { return };
+    /// The carrying vehicle's wheel displacements into its wheelsets.
+    pub(super) fn sync_carrier_wheels(&mut self) {
+        let Some(b) = &self.carrier else { return };
         let z = b.wheel_z();
-        for (k, zk) in z.into_iter().enumerate() {
+        for (k, zk) in z.into_iter().enumerate().take(b.wheelsets()) {
             if let Some(VehicleState::OnBogie { wheel_z }) =
                 self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
             {

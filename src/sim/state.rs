@@ -54,7 +54,7 @@ impl Simulation {
         }
         v.extend(self.motion.to_array());
         v.push(self.window.map_or(0.0, |w| w.origin_span as f64));
-        if let Some(b) = &self.bogie {
+        if let Some(b) = &self.carrier {
             v.extend(b.state_vector());
         }
         Ok(v)
@@ -121,7 +121,7 @@ impl Simulation {
         let per_wheelset = ForceExtremes::LEN + 2 + Accelerations::LEN;
         let extremes_end = CLOCK + per_wheelset * self.wheelsets.len();
         let head = extremes_end + Site::STATE_LEN * self.sites.len();
-        let nb = self.bogie.as_ref().map_or(0, |b| b.state_vector().len());
+        let nb = self.carrier.as_ref().map_or(0, |b| b.state_vector().len());
         let total = head + nt + nw * nv + Motion::LEN + 1 + nb;
         if v.len() != total {
             return Err(out_of_range(
@@ -179,10 +179,10 @@ impl Simulation {
                 _ => {}
             }
         }
-        if let Some(b) = &mut self.bogie {
+        if let Some(b) = &mut self.carrier {
             b.set_state_vector(&v[total - nb..])?;
         }
-        self.sync_bogie_wheels();
+        self.sync_carrier_wheels();
         self.motion = Motion::from_slice(tail);
         if let Some(w) = &mut self.window {
             w.origin_span = origin_span as i64;

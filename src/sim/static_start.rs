@@ -20,6 +20,7 @@ pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
         VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
         VehicleSpec::HalfCar(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::Wagon(p) => [p.static_wheel_load(); 2],
         VehicleSpec::AxleBox { static_load, .. } => {
             non_negative("static_load.left", static_load[0], "N")?;
             non_negative("static_load.right", static_load[1], "N")?;
@@ -129,15 +130,15 @@ impl Simulation {
                 }
             }
         }
-        if let Some(b) = &mut self.bogie {
-            let z = [0, 1].map(|k| {
+        if let Some(b) = &mut self.carrier {
+            let z: crate::vehicle::Axles = std::array::from_fn(|k| {
                 self.wheelsets
                     .get(k)
                     .and_then(|w| w.vehicle.wheel_z())
                     .unwrap_or([0.0; 2])
             });
-            b.set_static(z)?;
-            self.sync_bogie_wheels();
+            b.set_static(&z)?;
+            self.sync_carrier_wheels();
         }
         Ok(())
     }

@@ -24,8 +24,8 @@ fn run_pair(s: &Scenario, h_per_dt: u64, steps: usize) -> Vec<[f64; 2]> {
         wheel_radius: s.wheel_radius,
         dt: 0.0,
         axle_box: false,
-        half_car: None,
-        trailing_static_wheel_z: [0.0; 2],
+        model: UnitModel::RollPlane,
+        trailing_static_wheel_z: [[0.0; 2]; 3],
         static_wheel_z: track.wheel_z(),
     })
     .unwrap();
@@ -83,8 +83,8 @@ fn table_4_4_unit(
         dt: dt(&vp),
         static_wheel_z,
         axle_box: false,
-        half_car: None,
-        trailing_static_wheel_z: [0.0; 2],
+        model: UnitModel::RollPlane,
+        trailing_static_wheel_z: [[0.0; 2]; 3],
     }
 }
 

@@ -14,8 +14,8 @@ impl VehicleUnit {
         match &self.body {
             Body::RollPlane(v) => v.state_vector(),
             Body::Sprung { bogie, .. } => bogie.state_vector(),
-            Body::HalfCar(b) => b.state_vector(),
-            Body::SprungHalfCar(b) => b.state_vector(),
+            Body::Carrier(b) => b.state_vector(),
+            Body::SprungCarrier(b) => b.state_vector(),
         }
     }
 
@@ -108,8 +108,8 @@ impl VehicleUnit {
         match &mut self.body {
             Body::RollPlane(v) => v.set_state_vector(body)?,
             Body::Sprung { bogie, .. } => bogie.set_state_vector(body)?,
-            Body::HalfCar(b) => b.set_state_vector(body)?,
-            Body::SprungHalfCar(b) => b.set_state_vector(body)?,
+            Body::Carrier(b) => b.set_state_vector(body)?,
+            Body::SprungCarrier(b) => b.set_state_vector(body)?,
         }
         self.clock.dt = dt;
         self.clock.t0 = v[0];
@@ -185,8 +185,8 @@ impl VehicleUnit {
         let bad = match &self.body {
             Body::RollPlane(v) => v.beyond_bounds(),
             Body::Sprung { bogie, .. } => bogie.beyond_bounds(),
-            Body::HalfCar(b) => b.beyond_bounds(),
-            Body::SprungHalfCar(b) => b.beyond_bounds(),
+            Body::Carrier(b) => b.beyond_bounds(),
+            Body::SprungCarrier(b) => b.beyond_bounds(),
         };
         match bad {
             None => Ok(()),

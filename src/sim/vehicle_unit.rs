@@ -13,8 +13,9 @@ use super::clock::{Clock, ForceExtremes, StepPlan, Stepping};
 use crate::error::{Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, check};
 use crate::vehicle::{
-    CONTACT_STIFFNESS, ExchangeLimits, HalfCarBogie, HalfCarParams, HalfCarVector, Quad,
-    RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungHalfCar,
+    Axles, Bodies, CONTACT_STIFFNESS, ExchangeLimits, HalfCarBogie, HalfCarParams, MAX_AXLES,
+    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungHalfCar, SprungVehicle,
+    SprungWagon, Wagon, WagonParams,
 };
 use nalgebra::Vector6;
 
@@ -39,13 +40,44 @@ pub struct VehicleUnitParams {
     /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
     /// contact forces in.
     pub axle_box: bool,
-    /// The half-car bogie ([`HalfCarParams::from_roll_plane`] of `vehicle`, with its
-    /// wheelbase and side frames' pitch inertia) instead of the roll-plane vehicle: two
-    /// wheelsets, four contact (or primary) forces in.
-    pub half_car: Option<HalfCarParams>,
-    /// The second wheelset's static wheel-centre displacements `[left, right]` (m), for
-    /// the half-car bogie.
-    pub trailing_static_wheel_z: [f64; 2],
+    /// The vehicle on several wheelsets instead of the roll-plane vehicle on one: the
+    /// half-car bogie or the wagon.
+    pub model: UnitModel,
+    /// The static wheel-centre displacements `[left, right]` (m) of the wheelsets
+    /// behind the leading one, for a vehicle on several wheelsets.
+    pub trailing_static_wheel_z: [[f64; 2]; MAX_AXLES - 1],
+}
+
+impl VehicleUnitParams {
+    /// The static wheel-centre displacements of every wheelset (m), the leading one
+    /// first.
+    pub fn static_wheels(&self) -> Axles {
+        let t = &self.trailing_static_wheel_z;
+        [self.static_wheel_z, t[0], t[1], t[2]]
+    }
+}
+
+/// Which vehicle a [`VehicleUnit`] is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UnitModel {
+    /// The roll-plane vehicle ([`VehicleUnitParams::vehicle`]) on one wheelset.
+    RollPlane,
+    /// The half-car bogie ([`HalfCarParams::from_roll_plane`] of the vehicle, with its
+    /// wheelbase and side frames' pitch inertia): two wheelsets.
+    HalfCar(HalfCarParams),
+    /// The wagon ([`WagonParams`]): four wheelsets.
+    Wagon(WagonParams),
+}
+
+impl UnitModel {
+    /// Number of wheelsets.
+    pub fn wheelsets(&self) -> usize {
+        match self {
+            UnitModel::RollPlane => 1,
+            UnitModel::HalfCar(_) => 2,
+            UnitModel::Wagon(_) => 4,
+        }
+    }
 }
 
 /// What a [`VehicleUnit`] steps.
@@ -60,14 +92,16 @@ pub(super) enum Body {
         bogie: Box<SprungBogie>,
         rest: Box<RollPlaneVehicle>,
     },
-    /// The half-car bogie, the four contact forces in.
-    HalfCar(Box<HalfCarBogie>),
-    /// The half-car bogie above its primary suspension, the four primary forces in.
-    SprungHalfCar(Box<SprungHalfCar>),
+    /// A vehicle on several wheelsets, the contact forces of its wheels in.
+    Carrier(Box<dyn RailVehicle>),
+    /// A vehicle on several wheelsets above its primary suspension, the primary forces
+    /// at its axle boxes in.
+    SprungCarrier(Box<dyn SprungVehicle>),
 }
 
 /// A vehicle as a co-simulation unit: the six-DOF roll-plane vehicle (3.1-3.3,
-/// 3.24-3.27) or the half-car bogie ([`HalfCarBogie`], two wheelsets). The contact
+/// 3.24-3.27), the half-car bogie ([`HalfCarBogie`], two wheelsets) or the wagon
+/// ([`crate::vehicle::Wagon`], four). The contact
 /// forces `[left, right]` (N) of each wheelset come in and are held over each
 /// communication step (with the axle-box interface, the primary forces); the
 /// wheel-centre displacements (m), the axle angle (rad) and the bodies' motion go out.
@@ -81,15 +115,14 @@ pub struct VehicleUnit {
     /// [`crate::limits::MIN_STEP_FRACTION`] of it are carried over to the next call. Its step is the
     /// vehicle's.
     pub(super) clock: Clock,
-    /// The held forces of each wheelset (N); the second is unused by the roll-plane
-    /// vehicle.
-    pub(super) force: Quad,
+    /// The held forces of each wheelset (N); those past the vehicle's wheelsets unused.
+    pub(super) force: Axles,
     /// The forces that hold the vehicle at rest (N): contact forces, or primary forces
     /// with the axle-box interface.
-    pub(super) rest: Quad,
-    pub(super) extremes: [ForceExtremes; 2],
+    pub(super) rest: Axles,
+    pub(super) extremes: [ForceExtremes; MAX_AXLES],
     /// The wheels' accelerations of each wheelset (the rail signals unused).
-    pub(super) accelerations: [Accelerations; 2],
+    pub(super) accelerations: [Accelerations; MAX_AXLES],
     /// The axle rotation (rad) at `since` (s), from which it turns at the speed held
     /// since ([`VehicleUnit::set_speed`]).
     pub(super) rotation_ref: f64,
@@ -113,20 +146,21 @@ impl VehicleUnit {
         check("static_wheel_z.left", p.static_wheel_z[0])?;
         check("static_wheel_z.right", p.static_wheel_z[1])?;
         p.vehicle.validate()?;
-        if let Some(h) = &p.half_car {
-            check(
-                "wheelset[2].static_wheel_z.left",
-                p.trailing_static_wheel_z[0],
-            )?;
-            check(
-                "wheelset[2].static_wheel_z.right",
-                p.trailing_static_wheel_z[1],
-            )?;
-            h.validate()?;
+        let n = p.model.wheelsets();
+        for (z, k) in p.trailing_static_wheel_z.iter().take(n - 1).zip(2..) {
+            check(&format!("wheelset[{k}].static_wheel_z.left"), z[0])?;
+            check(&format!("wheelset[{k}].static_wheel_z.right"), z[1])?;
         }
-        let (critical, default_dt) = match &p.half_car {
-            Some(h) => (h.critical_time_step(), h.default_dt()),
-            None => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
+        let (critical, default_dt) = match &p.model {
+            UnitModel::RollPlane => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
+            UnitModel::HalfCar(h) => {
+                h.validate()?;
+                (h.critical_time_step(), h.default_dt())
+            }
+            UnitModel::Wagon(w) => {
+                w.validate()?;
+                (w.critical_time_step(), w.default_dt())
+            }
         };
         let dt = if p.dt == 0.0 { default_dt } else { p.dt };
         if !(dt >= MIN_DT_FRACTION * critical && dt <= 0.5 * critical) {
@@ -149,11 +183,29 @@ impl VehicleUnit {
             v.set_static(p.static_wheel_z)?;
             Ok(Box::new(v))
         };
-        let wheels = [p.static_wheel_z, p.trailing_static_wheel_z];
-        let mut force = [[p.vehicle.static_wheel_load(); 2]; 2];
-        let body = match (&p.half_car, p.axle_box) {
-            (None, false) => Body::RollPlane(roll_plane_at_rest()?),
-            (None, true) => {
+        let wheels = p.static_wheels();
+        let mut force = [[p.vehicle.static_wheel_load(); 2]; MAX_AXLES];
+        // The one place that knows the kinds: a vehicle on several wheelsets is a
+        // RailVehicle (whole) and a SprungVehicle (above its primary suspension).
+        let (whole, sprung): (Option<Box<dyn RailVehicle>>, Option<Box<dyn SprungVehicle>>) =
+            match (&p.model, p.axle_box) {
+                (UnitModel::RollPlane, _) => (None, None),
+                (UnitModel::HalfCar(h), false) => (Some(Box::new(HalfCarBogie::new(*h, dt)?)), None),
+                (UnitModel::HalfCar(h), true) => (None, Some(Box::new(SprungHalfCar::new(*h, dt)?))),
+                (UnitModel::Wagon(w), false) => (Some(Box::new(Wagon::new(*w, dt)?)), None),
+                (UnitModel::Wagon(w), true) => (None, Some(Box::new(SprungWagon::new(*w, dt)?))),
+            };
+        let body = match (whole, sprung, p.axle_box) {
+            (Some(mut b), _, _) => {
+                force = b.set_static(&wheels)?;
+                Body::Carrier(b)
+            }
+            (None, Some(mut b), _) => {
+                force = b.set_static(&wheels)?;
+                Body::SprungCarrier(b)
+            }
+            (None, None, false) => Body::RollPlane(roll_plane_at_rest()?),
+            (None, None, true) => {
                 let mut b = SprungBogie::new(p.vehicle, dt)?;
                 b.set_static(p.static_wheel_z)?;
                 let rest = roll_plane_at_rest()?;
@@ -163,17 +215,6 @@ impl VehicleUnit {
                     rest,
                 }
             }
-            (Some(h), false) => {
-                let mut b = HalfCarBogie::new(*h, dt)?;
-                b.set_static(wheels)?;
-                force = h.static_contact_forces(b.displacements());
-                Body::HalfCar(Box::new(b))
-            }
-            (Some(h), true) => {
-                let mut b = SprungHalfCar::new(*h, dt)?;
-                force = b.set_static(wheels)?;
-                Body::SprungHalfCar(Box::new(b))
-            }
         };
         let mut unit = VehicleUnit {
             params: *p,
@@ -182,7 +223,7 @@ impl VehicleUnit {
             force,
             rest: force,
             extremes: force.map(ForceExtremes::at),
-            accelerations: [Accelerations::NONE; 2],
+            accelerations: [Accelerations::NONE; MAX_AXLES],
             rotation_ref: 0.0,
             since: 0.0,
             exchange: None,
@@ -191,7 +232,7 @@ impl VehicleUnit {
             Body::Sprung { bogie, .. } => {
                 Some(bogie.exchange_limits(p.static_wheel_z, dt, CONTACT_STIFFNESS)?)
             }
-            Body::SprungHalfCar(b) => Some(b.exchange_limits(wheels, dt, CONTACT_STIFFNESS)?),
+            Body::SprungCarrier(b) => Some(b.exchange_limits(&wheels, dt, CONTACT_STIFFNESS)?),
             _ => None,
         };
         unit.check_states()?;
@@ -202,9 +243,10 @@ impl VehicleUnit {
     pub fn params(&self) -> &VehicleUnitParams {
         &self.params
     }
-    /// Number of wheelsets: 2 for the half-car bogie, 1 otherwise.
+    /// Number of wheelsets: 1 for the roll-plane vehicle, 2 for the half-car bogie, 4
+    /// for the wagon.
     pub fn wheelsets(&self) -> usize {
-        if self.params.half_car.is_some() { 2 } else { 1 }
+        self.params.model.wheelsets()
     }
     /// Static load on each wheel `[left, right]` (N).
     pub fn static_load(&self) -> [f64; 2] {
@@ -221,9 +263,10 @@ impl VehicleUnit {
     }
     /// Critical step of the vehicle's explicit scheme (s).
     pub fn critical_step(&self) -> f64 {
-        match &self.params.half_car {
-            Some(h) => h.critical_time_step(),
-            None => self.params.vehicle.critical_time_step(),
+        match &self.body {
+            Body::RollPlane(_) | Body::Sprung { .. } => self.params.vehicle.critical_time_step(),
+            Body::Carrier(b) => b.critical_time_step(),
+            Body::SprungCarrier(b) => b.critical_time_step(),
         }
     }
     /// Time (s).
@@ -274,9 +317,8 @@ impl VehicleUnit {
         }
         Some(match &self.body {
             Body::RollPlane(v) | Body::Sprung { rest: v, .. } => v.wheel_z(),
-            Body::HalfCar(b) => b.wheel_z()[k],
-            Body::SprungHalfCar(_) if k == 0 => self.params.static_wheel_z,
-            Body::SprungHalfCar(_) => self.params.trailing_static_wheel_z,
+            Body::Carrier(b) => b.wheel_z()[k],
+            Body::SprungCarrier(_) => self.params.static_wheels()[k],
         })
     }
     /// Wheel-centre velocities `[left, right]` (m/s) of wheelset `k`, backward
@@ -288,23 +330,19 @@ impl VehicleUnit {
             return None;
         }
         let h = 0.5 * self.params.vehicle.primary_spacing;
-        let (z, phi) = match &self.body {
+        Some(match &self.body {
             Body::RollPlane(v) => {
                 let v = v.velocities();
-                (v[4], v[5])
+                [v[4] - h * v[5], v[4] + h * v[5]]
             }
-            Body::HalfCar(b) => {
-                let v = b.velocities();
-                (v[6 + 2 * k], v[7 + 2 * k])
-            }
-            Body::Sprung { .. } | Body::SprungHalfCar(_) => (0.0, 0.0),
-        };
-        Some([z - h * phi, z + h * phi])
+            Body::Carrier(b) => b.wheel_velocities()[k],
+            Body::Sprung { .. } | Body::SprungCarrier(_) => [0.0; 2],
+        })
     }
     /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad) of the
     /// roll-plane vehicle; with the axle-box interface the wheelset's are its static
-    /// ones (the partner carries it). Zero for the half-car bogie
-    /// ([`VehicleUnit::half_car_displacements`]).
+    /// ones (the partner carries it). Zero for a vehicle on several wheelsets
+    /// ([`VehicleUnit::bodies`]).
     pub fn displacements(&self) -> Vector6<f64> {
         match &self.body {
             Body::RollPlane(v) => *v.displacements(),
@@ -313,24 +351,16 @@ impl VehicleUnit {
                 d.fixed_rows_mut::<4>(0).copy_from(bogie.displacements());
                 d
             }
-            Body::HalfCar(_) | Body::SprungHalfCar(_) => Vector6::zeros(),
+            Body::Carrier(_) | Body::SprungCarrier(_) => Vector6::zeros(),
         }
     }
-    /// Displacements of the half-car bogie (m, rad), in the order of
-    /// [`crate::vehicle::HALF_CAR_DOF_NAMES`]; with the axle-box interface the
-    /// wheelsets' are their static ones. `None` for the roll-plane vehicle.
-    pub fn half_car_displacements(&self) -> Option<HalfCarVector> {
-        let h = self.params.half_car.as_ref()?;
+    /// The bodies of a vehicle on several wheelsets (m, rad); with the axle-box
+    /// interface the wheelsets' are their static ones. `None` for the roll-plane
+    /// vehicle.
+    pub fn bodies(&self) -> Option<Bodies> {
         match &self.body {
-            Body::HalfCar(b) => Some(*b.displacements()),
-            Body::SprungHalfCar(b) => {
-                let mut d = h.static_state([
-                    self.params.static_wheel_z,
-                    self.params.trailing_static_wheel_z,
-                ])?;
-                d.fixed_rows_mut::<6>(0).copy_from(b.displacements());
-                Some(d)
-            }
+            Body::Carrier(b) => Some(b.bodies()),
+            Body::SprungCarrier(b) => b.bodies(&self.params.static_wheels()),
             _ => None,
         }
     }
@@ -347,8 +377,8 @@ impl VehicleUnit {
         }
         Some(match &self.body {
             Body::RollPlane(v) => v.bearing_forces(),
-            Body::Sprung { .. } | Body::SprungHalfCar(_) => self.force[k],
-            Body::HalfCar(b) => b.bearing_forces()[k],
+            Body::Sprung { .. } | Body::SprungCarrier(_) => self.force[k],
+            Body::Carrier(b) => b.bearing_forces()[k],
         })
     }
     /// The side frames' displacements and velocities `[left, right]` (m, m/s) at the
@@ -369,8 +399,11 @@ impl VehicleUnit {
                 let (d, v) = (r.displacements(), r.velocities());
                 ([d[2], d[3]], [v[2], v[3]])
             }
-            Body::HalfCar(b) => b.side_frames_of(k),
-            Body::SprungHalfCar(b) => {
+            Body::Carrier(b) => {
+                let (z, v) = b.side_frames();
+                (z[k], v[k])
+            }
+            Body::SprungCarrier(b) => {
                 let (z, v) = b.side_frames();
                 (z[k], v[k])
             }
@@ -389,7 +422,7 @@ impl VehicleUnit {
 
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
-        matches!(self.body, Body::Sprung { .. } | Body::SprungHalfCar(_))
+        matches!(self.body, Body::Sprung { .. } | Body::SprungCarrier(_))
     }
     /// The forces `[left, right]` (N) of wheelset `k` that hold the vehicle at rest
     /// (contact, or primary with the axle-box interface); `None` for a wheelset the
@@ -416,7 +449,7 @@ impl VehicleUnit {
         let Some(z) = self.wheel_z_of(k) else {
             return [[0.0; 2]; 3];
         };
-        let a = &self.accelerations[k.min(1)];
+        let a = &self.accelerations[k.min(MAX_AXLES - 1)];
         let now = a.now([z[0], z[1], 0.0, 0.0]);
         [now, a.max(now), a.min(now)].map(|x| [x[0], x[1]])
     }
@@ -424,11 +457,11 @@ impl VehicleUnit {
     /// Largest contact force per wheel of wheelset `k` that has driven a step (N); the
     /// static load before the first step.
     pub fn max_force_of(&self, k: usize) -> [f64; 2] {
-        self.extremes[k.min(1)].max
+        self.extremes[k.min(MAX_AXLES - 1)].max
     }
     /// Smallest contact force per wheel of wheelset `k` that has driven a step (N).
     pub fn min_force_of(&self, k: usize) -> [f64; 2] {
-        self.extremes[k.min(1)].min
+        self.extremes[k.min(MAX_AXLES - 1)].min
     }
     /// Largest contact force per wheel that has driven a step (N); the static load
     /// before the first step.
@@ -504,8 +537,8 @@ impl VehicleUnit {
             match &mut self.body {
                 Body::RollPlane(v) => v.change_dt(dt)?,
                 Body::Sprung { bogie, .. } => bogie.change_dt(dt)?,
-                Body::HalfCar(b) => b.change_dt(dt)?,
-                Body::SprungHalfCar(b) => b.change_dt(dt)?,
+                Body::Carrier(b) => b.change_dt(dt)?,
+                Body::SprungCarrier(b) => b.change_dt(dt)?,
             }
             self.clock.restart(dt);
         }
@@ -522,13 +555,14 @@ impl VehicleUnit {
                 v.step(self.force[0])
             }),
             Body::Sprung { bogie, .. } => (0..n).for_each(|_| bogie.step(self.force[0])),
-            Body::HalfCar(b) => (0..n).for_each(|_| {
-                for (a, z) in self.accelerations.iter_mut().zip(b.wheel_z()) {
+            Body::Carrier(b) => (0..n).for_each(|_| {
+                let w = b.wheelsets();
+                for (a, z) in self.accelerations.iter_mut().zip(b.wheel_z()).take(w) {
                     a.record([z[0], z[1], 0.0, 0.0], dt);
                 }
-                b.step(self.force)
+                b.step(&self.force)
             }),
-            Body::SprungHalfCar(b) => (0..n).for_each(|_| b.step(self.force)),
+            Body::SprungCarrier(b) => (0..n).for_each(|_| b.step(&self.force)),
         }
         for _ in 0..n {
             self.clock.tick();

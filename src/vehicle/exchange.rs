@@ -16,7 +16,11 @@
 //! and dampers. Measured against the whole model on the track
 //! (`examples/axle_box_masters.rs --limits`) it is in docs/VALIDATION.md.
 
-use super::{PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie, SprungHalfCar};
+use super::rail_vehicle::{Axles, SprungVehicle};
+use super::{
+    HalfCarParams, PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie,
+    SprungHalfCar, SprungWagon, WagonParams,
+};
 use crate::error::Result;
 use nalgebra::DMatrix;
 
@@ -130,10 +134,13 @@ impl TrackSide {
             });
             link.step(p);
         }
-        if self.links.len() == 2 {
-            let (a, b) = (self.links[0].last_force(), self.links[1].last_force());
-            self.links[0].set_partner_force(b);
-            self.links[1].set_partner_force(a);
+        // Each bogie's two wheelsets share their side frames.
+        if self.links.len() >= 2 {
+            for pair in self.links.chunks_exact_mut(2) {
+                let (a, b) = (pair[0].last_force(), pair[1].last_force());
+                pair[0].set_partner_force(b);
+                pair[1].set_partner_force(a);
+            }
         }
     }
 }
@@ -161,7 +168,7 @@ fn amplification<B: SprungBody>(
     let track = &track;
     let s0 = body.state();
     let nv = s0.len() - 1;
-    let moving = if track.links.len() == 2 {
+    let moving = if track.links.len() >= 2 {
         &LINK_MOVING[..]
     } else {
         &LINK_MOVING[..8]
@@ -335,26 +342,73 @@ impl SprungHalfCar {
     ///
     /// Errors: a parameter [`PrimaryLink::new`] refuses.
     pub fn exchange_limits(&self, z_box: Quad, base: f64, support: f64) -> Result<ExchangeLimits> {
-        let h = *self.params();
-        let inertia =
-            SideFrameInertia::pitching(h.sideframe_mass, h.sideframe_pitch_inertia, h.wheelbase);
-        // The wheelset and primary suspension only ([`PrimaryLink`] uses no more).
-        let wheelset = RollPlaneParams {
-            carbody_mass: 0.0,
-            bolster_mass: 0.0,
-            bolster_inertia: 0.0,
-            sideframe_mass: 0.0,
-            wheelset_mass: h.wheelset_mass,
-            wheelset_inertia: h.wheelset_inertia,
-            primary_stiffness: h.primary_stiffness,
-            primary_damping: h.primary_damping,
-            primary_spacing: h.primary_spacing,
-            secondary_stiffness: 0.0,
-            secondary_damping: 0.0,
-            secondary_spacing: 0.0,
-            gravity: h.gravity,
-        };
-        let track = track_side(self, &wheelset, inertia, &z_box.concat(), support)?;
+        let h = self.params();
+        let track = track_side(self, &wheelset_of(h), pitching(h), &z_box.concat(), support)?;
         Ok(limits_of(self, &track, base))
     }
+}
+
+/// The pitching side frames of a half-car bogie `h`.
+fn pitching(h: &HalfCarParams) -> SideFrameInertia {
+    SideFrameInertia::pitching(h.sideframe_mass, h.sideframe_pitch_inertia, h.wheelbase)
+}
+
+/// The wheelset and primary suspension of a half-car bogie `h` only ([`PrimaryLink`]
+/// uses no more).
+fn wheelset_of(h: &HalfCarParams) -> RollPlaneParams {
+    RollPlaneParams {
+        carbody_mass: 0.0,
+        bolster_mass: 0.0,
+        bolster_inertia: 0.0,
+        sideframe_mass: 0.0,
+        wheelset_mass: h.wheelset_mass,
+        wheelset_inertia: h.wheelset_inertia,
+        primary_stiffness: h.primary_stiffness,
+        primary_damping: h.primary_damping,
+        primary_spacing: h.primary_spacing,
+        secondary_stiffness: 0.0,
+        secondary_damping: 0.0,
+        secondary_spacing: 0.0,
+        gravity: h.gravity,
+    }
+}
+
+impl SprungBody for SprungWagon {
+    fn boxes(&self) -> usize {
+        8
+    }
+    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
+        let (z, v) = SprungVehicle::side_frames(self);
+        (z.concat(), v.concat())
+    }
+    fn step_boxes(&mut self, f: &[f64]) {
+        let a: Axles = [0, 1, 2, 3].map(|w| [f[2 * w], f[2 * w + 1]]);
+        SprungVehicle::step(self, &a);
+    }
+    fn state(&self) -> Vec<f64> {
+        SprungVehicle::state_vector(self)
+    }
+    fn set_state(&mut self, v: &[f64]) {
+        let _ = SprungVehicle::set_state_vector(self, v);
+    }
+    fn set_step(&mut self, dt: f64) {
+        let _ = SprungVehicle::change_dt(self, dt);
+    }
+}
+
+/// [`ExchangeLimits`] of the wagon above its primary suspensions `body` (of `p`) at rest
+/// with its axle boxes at `z_box` (m), as [`SprungHalfCar::exchange_limits`]: each
+/// bogie's pitching side frames shared by its two wheelsets.
+///
+/// Errors: a parameter [`PrimaryLink::new`] refuses.
+pub(super) fn wagon_limits(
+    body: &SprungWagon,
+    p: &WagonParams,
+    z_box: &Axles,
+    base: f64,
+    support: f64,
+) -> Result<ExchangeLimits> {
+    let h = &p.bogie;
+    let track = track_side(body, &wheelset_of(h), pitching(h), &z_box.concat(), support)?;
+    Ok(limits_of(body, &track, base))
 }

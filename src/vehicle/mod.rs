@@ -13,8 +13,10 @@
 //!   and [`SprungHalfCar`] advance it in time, whole or above its primary suspension.
 //! * [`WagonParams`]: a four-axle freight wagon, the car body in bounce, pitch and roll
 //!   on two half-car bogies, nineteen degrees of freedom, its matrices, natural
-//!   frequencies and static state; [`Wagon`] advances it in time (issue 28; not yet in
-//!   an FMU).
+//!   frequencies and static state; [`Wagon`] and [`SprungWagon`] advance it in time,
+//!   whole or above its primary suspensions.
+//! * [`RailVehicle`] and [`SprungVehicle`]: a vehicle on several wheelsets behind one
+//!   interface (the half-car bogie, the wagon), whole or above its primary suspension.
 //! * [`WheelsetBody`] and [`SprungBogie`]: the roll-plane vehicle cut at its axle boxes
 //!   (the primary suspension), for a bogie model that couples at its own step.
 //!
@@ -25,11 +27,13 @@ mod exchange;
 mod half_car;
 mod half_car_bogie;
 mod lumped;
+mod rail_vehicle;
 mod roll_plane;
 mod sprung_bogie;
 #[cfg(test)]
 mod tests;
 mod wagon;
+mod wagon_motion;
 #[cfg(test)]
 mod wagon_tests;
 
@@ -42,4 +46,6 @@ pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
-pub use wagon::{Octet, WAGON_DOFS, Wagon, WagonMatrix, WagonParams, WagonVector, bogie_start};
+pub use rail_vehicle::{Axles, Bodies, MAX_AXLES, RailVehicle, SprungVehicle};
+pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
+pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};

@@ -87,22 +87,18 @@ impl WagonParams {
         }
     }
 
-    /// Checks every parameter (the bogie's as the half-car's; the car body's masses and
-    /// inertias positive and finite; the bogie distance more than the wheelbase and at
-    /// most 30 m).
+    /// Checks every parameter: the bogie's as the half-car's; the car body's mass (a
+    /// quarter of it, `vehicle.carbody_mass`), its inertias and the bogie distance in
+    /// their ranges ([`crate::limits::check`]); the bogie distance more than the
+    /// wheelbase.
     pub fn validate(&self) -> Result<()> {
         self.bogie.validate()?;
-        for (name, v) in [
-            ("vehicle.carbody_mass", self.carbody_mass),
-            ("vehicle.carbody.pitch_inertia", self.carbody_pitch_inertia),
-            ("vehicle.carbody.roll_inertia", self.carbody_roll_inertia),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(out_of_range(name, v, "> 0 and finite"));
-            }
-        }
+        crate::limits::check("vehicle.carbody_mass", 0.25 * self.carbody_mass)?;
+        crate::limits::check("vehicle.carbody.pitch_inertia", self.carbody_pitch_inertia)?;
+        crate::limits::check("vehicle.carbody.roll_inertia", self.carbody_roll_inertia)?;
+        crate::limits::check("vehicle.bogie_distance", self.bogie_distance)?;
         let d = self.bogie_distance;
-        if !(d > self.bogie.wheelbase && d <= 30.0) {
+        if !(d > self.bogie.wheelbase) {
             return Err(out_of_range(
                 "vehicle.bogie_distance",
                 d,
@@ -302,90 +298,5 @@ impl WagonParams {
                 [0.5 * (f - m / hw), 0.5 * (f + m / hw)]
             })
         })
-    }
-}
-
-/// Forces or displacements of the eight wheels: `[b][i]` `[left, right]` of wheelset
-/// `i` (0 leading) of bogie `b` (0 front).
-pub type Octet = [[[f64; 2]; 2]; 2];
-
-/// The wagon in time: nineteen degrees of freedom under gravity and the eight contact
-/// forces, by the central differences of the roll-plane vehicle with the damping as in
-/// (3.25) (the half-car bogie's scheme).
-#[derive(Debug, Clone)]
-pub struct Wagon {
-    params: WagonParams,
-    cd: crate::numerics::CentralDifference<WAGON_DOFS>,
-    gravity: WagonVector,
-}
-
-impl WagonParams {
-    /// Critical step of central differences on the fastest mode (s), `2 / omega_max`.
-    pub fn critical_time_step(&self) -> f64 {
-        2.0 / self.natural_frequencies()[WAGON_DOFS - 1]
-    }
-}
-
-impl Wagon {
-    /// The wagon of `params` at rest at zero, stepped with `dt` (s).
-    ///
-    /// Errors: a parameter [`WagonParams::validate`] refuses; `dt` not positive or above
-    /// [`WagonParams::critical_time_step`].
-    pub fn new(params: WagonParams, dt: f64) -> Result<Wagon> {
-        params.validate()?;
-        crate::error::positive("solver.dt", dt, "s")?;
-        crate::numerics::check_critical_step(dt, params.critical_time_step(), "wagon")?;
-        Ok(Wagon {
-            params,
-            cd: crate::numerics::CentralDifference::new(
-                &params.mass_diagonal(),
-                params.stiffness_matrix(),
-                params.damping_matrix(),
-                dt,
-            ),
-            gravity: params.gravity_force(),
-        })
-    }
-
-    /// Parameters.
-    pub fn params(&self) -> &WagonParams {
-        &self.params
-    }
-
-    /// Displacements `d` at `t_j` (m, rad), in the order of the module's docs.
-    pub fn displacements(&self) -> &WagonVector {
-        self.cd.d()
-    }
-
-    /// Wheel-centre displacements `[b][i]` `[left, right]` (m): `z_w -+ L_w/2 phi_w`.
-    pub fn wheel_z(&self) -> Octet {
-        let (d, h) = (self.cd.d(), 0.5 * self.params.bogie.primary_spacing);
-        [0, 1].map(|b| {
-            let s = bogie_start(b);
-            [0, 1].map(|i| {
-                let (z, phi) = (d[s + 4 + 2 * i], d[s + 5 + 2 * i]);
-                [z - h * phi, z + h * phi]
-            })
-        })
-    }
-
-    /// Advances one step from `t_j` under the contact forces `p` (N, up on the wheels)
-    /// at `t_j`.
-    pub fn step(&mut self, p: Octet) {
-        self.cd.advance(self.gravity + self.params.contact_force(p));
-    }
-
-    /// Static equilibrium with the wheels held at `z_wheel` (m)
-    /// ([`WagonParams::static_state`]).
-    ///
-    /// Errors: a suspension that does not hold the bodies.
-    pub fn set_static(&mut self, z_wheel: Octet) -> Result<()> {
-        let d = self.params.static_state(z_wheel).ok_or_else(|| {
-            crate::error::Error::Unsupported(
-                "static equilibrium of the wagon: the suspension does not hold the bodies".into(),
-            )
-        })?;
-        self.cd.set_state(d, d);
-        Ok(())
     }
 }

@@ -98,6 +98,18 @@ pub fn icon(id: &str) -> Vec<u8> {
             c.track(100);
             c.wheel(64.0, 58.0, 42.0, 6.0);
         }
+        "Wagon" => {
+            c.rect(6, 10, 122, 34, BODY);
+            c.spring(28, 34, 48);
+            c.spring(100, 34, 48);
+            c.rect(8, 48, 50, 58, STEEL);
+            c.rect(78, 48, 120, 58, STEEL);
+            c.track(104);
+            c.wheel(18.0, 90.0, 12.0, 3.0);
+            c.wheel(40.0, 90.0, 12.0, 0.0);
+            c.wheel(88.0, 90.0, 12.0, 0.0);
+            c.wheel(110.0, 90.0, 12.0, 0.0);
+        }
         "RollPlaneVehicle" => {
             c.rect(14, 8, 114, 30, BODY);
             c.spring(30, 30, 52);

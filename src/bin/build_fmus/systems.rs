@@ -1,5 +1,5 @@
 //! The system structures shipped beside the FMUs, under `<out>/systems/`: TrackContact
-//! with each vehicle (RollPlaneVehicle, HalfCarBogie) at each interface (contact,
+//! with each vehicle (RollPlaneVehicle, HalfCarBogie, Wagon) at each interface (contact,
 //! axle_box), as
 //!
 //! - an SSP 1.0 archive, `<system>.ssp`: `SystemStructure.ssd` at its root, both FMUs
@@ -285,20 +285,23 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
         value(track, "track.window.behind", WINDOW),
     ];
     if n > 1 {
-        // A bogie: the track carries its wheelsets at its wheelbase, and at the axle
-        // boxes the half-car's pitching side frames.
-        assert_eq!(n, 2, "a vehicle on {n} wheelsets");
+        // A bogie or the wagon: the track carries its wheelsets at their offsets (the
+        // wheelbase, and the wagon's bogie distance), and at the axle boxes the bogies'
+        // pitching side frames.
+        let a = spec(vehicle, "vehicle.wheelbase").start;
+        let (offsets, model) = match n {
+            2 => (vec![a], enums::vehicle_model::HALF_CAR),
+            4 => {
+                let d = spec(vehicle, "vehicle.bogie_distance").start;
+                (vec![a, d, d + a], enums::vehicle_model::WAGON)
+            }
+            _ => panic!("a vehicle on {n} wheelsets"),
+        };
         track_values.push(value(track, "wheelsets", n as f64));
-        track_values.push(value(
-            track,
-            "wheelset[2].offset",
-            spec(vehicle, "vehicle.wheelbase").start,
-        ));
-        track_values.push(value(
-            track,
-            "vehicle.model",
-            enums::vehicle_model::HALF_CAR,
-        ));
+        for (x, k) in offsets.into_iter().zip(2..) {
+            track_values.push(value(track, &format!("wheelset[{k}].offset"), x));
+        }
+        track_values.push(value(track, "vehicle.model", model));
     }
     let vehicle_values = vec![
         value(vehicle, "speed", speed),
@@ -325,10 +328,10 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
     }
 }
 
-/// The four shipped systems.
+/// The six shipped systems.
 pub fn systems() -> Vec<System> {
     let mut all = Vec::new();
-    for vehicle in ["RollPlaneVehicle", "HalfCarBogie"] {
+    for vehicle in ["RollPlaneVehicle", "HalfCarBogie", "Wagon"] {
         for interface in [Interface::Contact, Interface::AxleBox] {
             all.push(system(vehicle, interface));
         }

@@ -1,4 +1,4 @@
-//! This project's four FMUs over the FMI 2.0 layer: which FMU an instance is
+//! This project's five FMUs over the FMI 2.0 layer: which FMU an instance is
 //! ([`Kind`]), the engine's parameters from its variables, its outputs, and the
 //! [`FmuModel`] that implements [`crate::fmu::fmi2::Model`].
 
@@ -15,7 +15,7 @@ pub use unit::{END_ZONE_SPANS, FmuModel};
 
 use crate::fmu::vars::{self, FmuTable};
 
-/// Which of the four FMUs an instance is.
+/// Which of the five FMUs an instance is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kind {
     /// Track and contact, wheels as inputs.
@@ -26,15 +26,18 @@ pub enum Kind {
     CoupledSystem,
     /// The half-car bogie, contact (or primary) forces of two wheelsets as inputs.
     HalfCarBogie,
+    /// The four-axle wagon, contact (or primary) forces of four wheelsets as inputs.
+    Wagon,
 }
 
 impl Kind {
-    /// The four FMUs.
-    pub const ALL: [Kind; 4] = [
+    /// The five FMUs.
+    pub const ALL: [Kind; 5] = [
         Kind::TrackContact,
         Kind::RollPlaneVehicle,
         Kind::CoupledSystem,
         Kind::HalfCarBogie,
+        Kind::Wagon,
     ];
 
     /// The FMU with this GUID.
@@ -49,6 +52,7 @@ impl Kind {
             Kind::RollPlaneVehicle => &vars::ROLL_PLANE_VEHICLE,
             Kind::CoupledSystem => &vars::COUPLED_SYSTEM,
             Kind::HalfCarBogie => &vars::HALF_CAR_BOGIE,
+            Kind::Wagon => &vars::WAGON,
         }
     }
 }
@@ -56,7 +60,7 @@ impl Kind {
 impl crate::fmu::Instance {
     /// Which FMU this instance is.
     pub fn kind(&self) -> Kind {
-        Kind::from_guid(self.table().guid).expect("an instance of one of the four FMUs")
+        Kind::from_guid(self.table().guid).expect("an instance of one of the five FMUs")
     }
 
     /// The scenario the variables of a track-carrying FMU describe.

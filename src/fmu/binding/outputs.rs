@@ -114,21 +114,22 @@ impl FmuModel {
                 .map_or(f64::NAN, |r| f(&r)),
             View::Vehicle(_) => f64::NAN,
         };
-        // The half-car bogie's displacements, where there is one (HalfCarBogie, or
-        // CoupledSystem with vehicle.model = half_car).
-        let half_car = match view {
-            View::Vehicle(u) => u.half_car_displacements(),
-            View::Sim(sim, _) => sim.bogie().map(|b| *b.displacements()),
+        // The bodies of a vehicle on several wheelsets, where there is one
+        // (HalfCarBogie, Wagon, or CoupledSystem with vehicle.model = half_car or
+        // wagon).
+        let bodies = match view {
+            View::Vehicle(u) => u.bodies(),
+            View::Sim(sim, _) => sim.carrier().map(|b| b.bodies()),
         };
+        let w = index.min(crate::vehicle::MAX_AXLES - 1);
         // The roll-plane vehicle's displacements `{z_b, phi_b, z_sfl, z_sfr, z_w,
-        // phi_w}` with the half-car's in their place (the side frames at their centres,
-        // wheelset `index`'s bounce and roll).
+        // phi_w}` (0, 1, 4 and 5 read) with those of the bogie over wheelset `index` in
+        // their place.
         let body = |k: usize| {
-            if let Some(d) = &half_car {
+            if let Some(b) = &bodies {
                 return match k {
-                    0 | 1 => d[k],
-                    2 | 3 => d[2 + 2 * (k - 2)],
-                    _ => d[6 + 2 * index + (k - 4)],
+                    0 | 1 => b.bolster[w][k],
+                    _ => b.wheelset[w][k - 4],
                 };
             }
             match view {
@@ -144,8 +145,11 @@ impl FmuModel {
         let frames = || match view {
             View::Vehicle(u) => u.side_frames_of(index),
             View::Sim(sim, _) => {
-                match (sim.bogie(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
-                    (Some(b), _) => Some(b.side_frames_of(index)),
+                match (sim.carrier(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                    (Some(b), _) => {
+                        let (z, v) = b.side_frames();
+                        Some((z[w], v[w]))
+                    }
                     (None, Some(VehicleState::RollPlane(v))) => {
                         let (d, v) = (v.displacements(), v.velocities());
                         Some(([d[2], d[3]], [v[2], v[3]]))
@@ -160,8 +164,8 @@ impl FmuModel {
         let bearing = || match view {
             View::Vehicle(u) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
             View::Sim(sim, _) => {
-                match (sim.bogie(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
-                    (Some(b), _) => b.bearing_forces()[index.min(1)][side],
+                match (sim.carrier(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                    (Some(b), _) => b.bearing_forces()[w][side],
                     (None, Some(VehicleState::RollPlane(v))) => v.bearing_forces()[side],
                     (None, Some(VehicleState::AxleBox(link))) => link.force_now()[side],
                     _ => 0.0,
@@ -221,12 +225,15 @@ impl FmuModel {
                 View::Sim(_, s) => s.position,
                 View::Vehicle(_) => f64::NAN,
             },
+            Quantity::CarbodyZ => bodies.map_or(0.0, |b| b.carbody[0]),
+            Quantity::CarbodyPitch => bodies.map_or(0.0, |b| b.carbody[1]),
+            Quantity::CarbodyRoll => bodies.map_or(0.0, |b| b.carbody[2]),
             Quantity::BolsterZ => body(0),
             Quantity::BolsterRoll => body(1),
             // Above the axle boxes of wheelset `index` (the half-car's side frames pitch).
             Quantity::SideframeZ => frames().map_or(f64::NAN, |f| f.0[side]),
             Quantity::SideframeV => frames().map_or(f64::NAN, |f| f.1[side]),
-            Quantity::SideframePitch => half_car.map_or(0.0, |d| d[3 + 2 * side]),
+            Quantity::SideframePitch => bodies.map_or(0.0, |b| b.sideframe_pitch[w][side]),
             // `wheelset.z`, `.roll` of the leading wheelset, `wheelset[2].z`, `.roll`.
             Quantity::WheelsetZ | Quantity::Z => body(4),
             Quantity::WheelsetRoll | Quantity::Roll => body(5),

@@ -8,7 +8,7 @@ use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
 use crate::numerics::Table;
-use crate::sim::VehicleUnitParams;
+use crate::sim::{UnitModel, VehicleUnitParams};
 use crate::sim::{
     Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
@@ -16,7 +16,7 @@ use crate::track::{
     RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
     TrackParams,
 };
-use crate::vehicle::{HalfCarParams, RollPlaneParams};
+use crate::vehicle::{HalfCarParams, RollPlaneParams, WagonParams};
 use crate::wheel::{FlatShape, FlatSpec, OutOfRoundness};
 use std::sync::Arc;
 
@@ -116,30 +116,64 @@ fn half_car_params(v: &[f64], wheelbase: f64) -> HalfCarParams {
     )
 }
 
-/// The vehicle as a co-simulation unit (RollPlaneVehicle, HalfCarBogie).
+/// The wagon of the roll-plane vehicle's parameters (table 4.4: the car body four
+/// times its quarter, each bogie the half-car of [`half_car_params`]) with the
+/// wheelbase `wheelbase` (m), the bogie centre distance `distance` (m) and the car
+/// body's inertias of the variables.
+fn wagon_params(v: &[f64], wheelbase: f64, distance: f64) -> WagonParams {
+    WagonParams {
+        carbody_mass: 4.0 * v[vr::VEHICLE_CARBODY_MASS as usize],
+        carbody_pitch_inertia: v[vr::VEHICLE_CARBODY_PITCH_INERTIA as usize],
+        carbody_roll_inertia: v[vr::VEHICLE_CARBODY_ROLL_INERTIA as usize],
+        bogie_distance: distance,
+        bogie: half_car_params(v, wheelbase),
+    }
+}
+
+/// The vehicle as a co-simulation unit (RollPlaneVehicle, HalfCarBogie, Wagon).
 pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
-    let half_car =
-        (kind == Kind::HalfCarBogie).then(|| half_car_params(v, v[vr::VEHICLE_WHEELBASE as usize]));
+    let val = |r: u32| v[r as usize];
+    let model = match kind {
+        Kind::HalfCarBogie => UnitModel::HalfCar(half_car_params(v, val(vr::VEHICLE_WHEELBASE))),
+        Kind::Wagon => UnitModel::Wagon(wagon_params(
+            v,
+            val(vr::VEHICLE_WHEELBASE),
+            val(vr::VEHICLE_BOGIE_DISTANCE),
+        )),
+        _ => UnitModel::RollPlane,
+    };
+    // Only a vehicle on several wheelsets has the trailing wheelsets' (the others'
+    // values are not theirs).
+    const TRAILING_STATIC: [[u32; 2]; 3] = [
+        [
+            vr::WHEELSET_2_STATIC_WHEEL_Z_LEFT,
+            vr::WHEELSET_2_STATIC_WHEEL_Z_RIGHT,
+        ],
+        [
+            vr::WHEELSET_3_STATIC_WHEEL_Z_LEFT,
+            vr::WHEELSET_3_STATIC_WHEEL_Z_RIGHT,
+        ],
+        [
+            vr::WHEELSET_4_STATIC_WHEEL_Z_LEFT,
+            vr::WHEELSET_4_STATIC_WHEEL_Z_RIGHT,
+        ],
+    ];
+    let n = model.wheelsets();
     VehicleUnitParams {
         vehicle: vehicle_params(v),
-        speed: v[vr::SPEED as usize],
-        wheel_radius: v[vr::WHEEL_RADIUS as usize],
-        dt: v[vr::SOLVER_DT as usize],
-        static_wheel_z: [
-            v[vr::STATIC_WHEEL_Z_LEFT as usize],
-            v[vr::STATIC_WHEEL_Z_RIGHT as usize],
-        ],
+        speed: val(vr::SPEED),
+        wheel_radius: val(vr::WHEEL_RADIUS),
+        dt: val(vr::SOLVER_DT),
+        static_wheel_z: [val(vr::STATIC_WHEEL_Z_LEFT), val(vr::STATIC_WHEEL_Z_RIGHT)],
         axle_box: axle_box(v),
-        half_car,
-        // Only the half-car bogie has the second wheelset's (the others' values are
-        // not theirs).
-        trailing_static_wheel_z: match half_car {
-            Some(_) => [
-                v[vr::WHEELSET_2_STATIC_WHEEL_Z_LEFT as usize],
-                v[vr::WHEELSET_2_STATIC_WHEEL_Z_RIGHT as usize],
-            ],
-            None => [0.0; 2],
-        },
+        model,
+        trailing_static_wheel_z: std::array::from_fn(|k| {
+            if k + 1 < n {
+                TRAILING_STATIC[k].map(val)
+            } else {
+                [0.0; 2]
+            }
+        }),
     }
 }
 
@@ -186,10 +220,15 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         Kind::CoupledSystem if val(vr::VEHICLE_MODEL) == enums::vehicle_model::HALF_CAR => {
             VehicleSpec::HalfCar(half_car_params(v, val(OFFSET_VRS[0])))
         }
+        // The wagon's wheelbase and bogie distance are the offsets of wheelsets 2 and 3
+        // (the engine checks the fourth).
+        Kind::CoupledSystem if val(vr::VEHICLE_MODEL) == enums::vehicle_model::WAGON => {
+            VehicleSpec::Wagon(wagon_params(v, val(OFFSET_VRS[0]), val(OFFSET_VRS[1])))
+        }
         Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
         _ if axle_box(v) => VehicleSpec::AxleBox {
             vehicle: wheelset_params(v),
-            side_frames: if val(vr::VEHICLE_MODEL) == enums::vehicle_model::HALF_CAR {
+            side_frames: if val(vr::VEHICLE_MODEL) != enums::vehicle_model::ROLL_PLANE {
                 SideFrameSpec::HalfCar {
                     mass: 2.0 * val(vr::VEHICLE_SIDEFRAME_MASS),
                     pitch_inertia: val(vr::VEHICLE_SIDEFRAME_PITCH_INERTIA),

@@ -31,20 +31,36 @@ pub(super) const FRAME_VRS: [u32; 4] = [
 ];
 
 /// The vehicle units' contact-force inputs of each wheelset: left, right.
-const VEHICLE_CONTACT_VRS: [[u32; 2]; 2] = [
+const VEHICLE_CONTACT_VRS: [[u32; 2]; 4] = [
     [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
     [
         vr::WHEELSET_2_CONTACT_LEFT_FORCE,
         vr::WHEELSET_2_CONTACT_RIGHT_FORCE,
     ],
+    [
+        vr::WHEELSET_3_CONTACT_LEFT_FORCE,
+        vr::WHEELSET_3_CONTACT_RIGHT_FORCE,
+    ],
+    [
+        vr::WHEELSET_4_CONTACT_LEFT_FORCE,
+        vr::WHEELSET_4_CONTACT_RIGHT_FORCE,
+    ],
 ];
 
 /// The vehicle units' primary-force inputs of each wheelset (`interface = axle_box`).
-const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 2] = [
+const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 4] = [
     [vr::AXLE_BOX_LEFT_FORCE, vr::AXLE_BOX_RIGHT_FORCE],
     [
         vr::WHEELSET_2_AXLE_BOX_LEFT_FORCE,
         vr::WHEELSET_2_AXLE_BOX_RIGHT_FORCE,
+    ],
+    [
+        vr::WHEELSET_3_AXLE_BOX_LEFT_FORCE,
+        vr::WHEELSET_3_AXLE_BOX_RIGHT_FORCE,
+    ],
+    [
+        vr::WHEELSET_4_AXLE_BOX_LEFT_FORCE,
+        vr::WHEELSET_4_AXLE_BOX_RIGHT_FORCE,
     ],
 ];
 
@@ -186,19 +202,13 @@ impl Model for FmuModel {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
         })?;
         let (engine, published) = match kind {
-            Kind::RollPlaneVehicle | Kind::HalfCarBogie => {
+            Kind::RollPlaneVehicle | Kind::HalfCarBogie | Kind::Wagon => {
                 let p = vehicle_unit_params(kind, values);
                 let u = VehicleUnit::new(&p)?;
                 let published = Published {
                     static_load: u.static_load(),
                     static_wheel_z: p.static_wheel_z,
-                    trailing_static_wheel_z: std::array::from_fn(|k| {
-                        if k == 0 {
-                            p.trailing_static_wheel_z
-                        } else {
-                            [0.0; 2]
-                        }
-                    }),
+                    trailing_static_wheel_z: p.trailing_static_wheel_z,
                     step: u.dt_base(),
                     critical_step: u.critical_step(),
                     kw_used: 0.0,
@@ -341,8 +351,8 @@ impl Model for FmuModel {
             // half-car's contact forces (which share its weight by its static state).
             let refs = match (u.is_axle_box(), u.wheelsets()) {
                 (true, _) => VEHICLE_AXLE_BOX_VRS,
-                (false, 2) => VEHICLE_CONTACT_VRS,
-                (false, _) => return None,
+                (false, 1) => return None,
+                (false, _) => VEHICLE_CONTACT_VRS,
             };
             for (k, [l, rr]) in refs.into_iter().take(u.wheelsets()).enumerate() {
                 let f = u.held_forces_of(k)?;

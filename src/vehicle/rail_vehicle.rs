@@ -1,0 +1,258 @@
+//! A vehicle on several wheelsets behind one interface: [`RailVehicle`], the whole
+//! vehicle under the contact forces of its wheels (the half-car bogie, the wagon), and
+//! [`SprungVehicle`], the same vehicle above its primary suspension under the primary
+//! forces at its axle boxes. The assembly (`crate::sim`) steps either without knowing
+//! which vehicle it is: a new kind implements these traits in its own file, and is
+//! built in one match arm of the scenario's vehicle.
+//!
+//! Wheelsets are numbered from the leading one (0); a value of each wheelset is
+//! `[left, right]`, in an [`Axles`] of which the first [`RailVehicle::wheelsets`] are
+//! used.
+
+use super::{ExchangeLimits, HalfCarBogie, SprungHalfCar};
+use crate::error::Result;
+
+/// Most wheelsets one vehicle rests on (the wagon's four).
+pub const MAX_AXLES: usize = 4;
+
+/// A value `[left, right]` of each wheelset, the leading one first; the entries past
+/// the vehicle's wheelsets are unused (zero).
+pub type Axles = [[f64; 2]; MAX_AXLES];
+
+/// The motion of a vehicle's bodies, as its outputs give it (m, rad; roll positive
+/// raising the right side, pitch raising the front).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Bodies {
+    /// The car body's bounce, pitch and roll at its centre (the wagon; zero for a bogie
+    /// alone, whose bolster carries its share of the car body).
+    pub carbody: [f64; 3],
+    /// `[bounce, roll]` of the bolster of the bogie over each wheelset.
+    pub bolster: Axles,
+    /// `[left, right]` pitch of the side frames over each wheelset.
+    pub sideframe_pitch: Axles,
+    /// `[bounce, roll]` of each wheelset.
+    pub wheelset: Axles,
+}
+
+/// A whole vehicle on several wheelsets, driven by the contact forces of its wheels.
+pub trait RailVehicle: std::fmt::Debug + Send + Sync {
+    /// Number of wheelsets (2 for the half-car bogie, 4 for the wagon).
+    fn wheelsets(&self) -> usize;
+    /// Step (s).
+    fn dt(&self) -> f64;
+    /// Critical step of central differences on the fastest mode (s).
+    fn critical_time_step(&self) -> f64;
+    /// Wheel-centre displacements of every wheelset (m).
+    fn wheel_z(&self) -> Axles;
+    /// Wheel-centre velocities of every wheelset (m/s), backward differences over the
+    /// last step.
+    fn wheel_velocities(&self) -> Axles;
+    /// Primary suspension (bearing) forces at every axle box (N), positive pressing the
+    /// wheelset down.
+    fn bearing_forces(&self) -> Axles;
+    /// The side frames' displacements and velocities above every wheelset's axle boxes
+    /// (m, m/s; the side frames' pitch included).
+    fn side_frames(&self) -> (Axles, Axles);
+    /// Displacements of every degree of freedom at `t_j` (m, rad), in the model's order.
+    fn displacements(&self) -> &[f64];
+    /// The bodies' motion at `t_j`.
+    fn bodies(&self) -> Bodies;
+    /// Advances one step from `t_j` under the contact forces `p` (N, up on the wheels).
+    fn step(&mut self, p: &Axles);
+    /// Static equilibrium with the wheels held at `z` (m); returns the contact forces
+    /// that hold it (N).
+    ///
+    /// Errors: a suspension that does not hold the bodies.
+    fn set_static(&mut self, z: &Axles) -> Result<Axles>;
+    /// Changes the step to `dt` (s), keeping the displacements and velocities.
+    ///
+    /// Errors: `dt` not positive or above the critical step.
+    fn change_dt(&mut self, dt: f64) -> Result<()>;
+    /// `[dt, d, d_prev]`.
+    fn state_vector(&self) -> Vec<f64>;
+    /// Restores [`RailVehicle::state_vector`].
+    ///
+    /// Errors: a wrong length, a step the vehicle refuses.
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<()>;
+    /// The first value beyond the health bounds: its name, value and limit.
+    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)>;
+    /// A copy behind a new box.
+    fn clone_box(&self) -> Box<dyn RailVehicle>;
+}
+
+impl Clone for Box<dyn RailVehicle> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+/// A vehicle above its primary suspension, driven by the primary forces at its axle
+/// boxes; its partner carries the wheelsets ([`super::PrimaryLink`]).
+pub trait SprungVehicle: std::fmt::Debug + Send + Sync {
+    /// Number of wheelsets under it.
+    fn wheelsets(&self) -> usize;
+    /// Critical step of central differences on the whole vehicle's fastest mode (s).
+    fn critical_time_step(&self) -> f64;
+    /// The side frames' displacements and velocities above every wheelset's axle boxes
+    /// (m, m/s).
+    fn side_frames(&self) -> (Axles, Axles);
+    /// The bodies' motion, the wheelsets at rest on `z` (m); `None` when the suspension
+    /// does not hold them there.
+    fn bodies(&self, z: &Axles) -> Option<Bodies>;
+    /// Advances one step under the primary forces `f` (N, pressing the axle boxes down)
+    /// held over it.
+    fn step(&mut self, f: &Axles);
+    /// Static equilibrium with the axle boxes (wheels) at `z` (m); returns the static
+    /// primary forces (N).
+    ///
+    /// Errors: a suspension that does not hold the bodies.
+    fn set_static(&mut self, z: &Axles) -> Result<Axles>;
+    /// As [`RailVehicle::change_dt`].
+    fn change_dt(&mut self, dt: f64) -> Result<()>;
+    /// `[dt, d, d_prev]`.
+    fn state_vector(&self) -> Vec<f64>;
+    /// Restores [`SprungVehicle::state_vector`].
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<()>;
+    /// A body beyond the health bounds.
+    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)>;
+    /// The largest stable communication steps of the exchange at rest on `z` (m), with
+    /// substeps of at most `base` (s) and contact springs of `support` (N/m per wheel)
+    /// ([`ExchangeLimits`]).
+    ///
+    /// Errors: a parameter [`super::PrimaryLink::new`] refuses.
+    fn exchange_limits(&self, z: &Axles, base: f64, support: f64) -> Result<ExchangeLimits>;
+    /// A copy behind a new box.
+    fn clone_box(&self) -> Box<dyn SprungVehicle>;
+}
+
+impl Clone for Box<dyn SprungVehicle> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+/// The first two wheelsets of `a`.
+fn pair(a: &Axles) -> super::Quad {
+    [a[0], a[1]]
+}
+
+/// `q` as the first two wheelsets.
+fn axles(q: super::Quad) -> Axles {
+    [q[0], q[1], [0.0; 2], [0.0; 2]]
+}
+
+/// The half-car bogie's bodies of its displacements `d` (in the order of
+/// [`super::HALF_CAR_DOF_NAMES`]).
+fn half_car_bodies(d: &super::HalfCarVector) -> Bodies {
+    let bolster = [d[0], d[1]];
+    let pitch = [d[3], d[5]];
+    Bodies {
+        carbody: [0.0; 3],
+        bolster: axles([bolster, bolster]),
+        sideframe_pitch: axles([pitch, pitch]),
+        wheelset: axles([[d[6], d[7]], [d[8], d[9]]]),
+    }
+}
+
+impl RailVehicle for HalfCarBogie {
+    fn wheelsets(&self) -> usize {
+        2
+    }
+    fn dt(&self) -> f64 {
+        HalfCarBogie::dt(self)
+    }
+    fn critical_time_step(&self) -> f64 {
+        self.params().critical_time_step()
+    }
+    fn wheel_z(&self) -> Axles {
+        axles(HalfCarBogie::wheel_z(self))
+    }
+    fn wheel_velocities(&self) -> Axles {
+        let v = self.velocities();
+        let h = 0.5 * self.params().primary_spacing;
+        axles([0, 1].map(|k| {
+            let (z, phi) = (v[6 + 2 * k], v[7 + 2 * k]);
+            [z - h * phi, z + h * phi]
+        }))
+    }
+    fn bearing_forces(&self) -> Axles {
+        axles(HalfCarBogie::bearing_forces(self))
+    }
+    fn side_frames(&self) -> (Axles, Axles) {
+        let [(z0, v0), (z1, v1)] = [0, 1].map(|k| self.side_frames_of(k));
+        (axles([z0, z1]), axles([v0, v1]))
+    }
+    fn displacements(&self) -> &[f64] {
+        HalfCarBogie::displacements(self).as_slice()
+    }
+    fn bodies(&self) -> Bodies {
+        half_car_bodies(HalfCarBogie::displacements(self))
+    }
+    fn step(&mut self, p: &Axles) {
+        HalfCarBogie::step(self, pair(p))
+    }
+    fn set_static(&mut self, z: &Axles) -> Result<Axles> {
+        HalfCarBogie::set_static(self, pair(z))?;
+        Ok(axles(
+            self.params()
+                .static_contact_forces(HalfCarBogie::displacements(self)),
+        ))
+    }
+    fn change_dt(&mut self, dt: f64) -> Result<()> {
+        HalfCarBogie::change_dt(self, dt)
+    }
+    fn state_vector(&self) -> Vec<f64> {
+        HalfCarBogie::state_vector(self)
+    }
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        HalfCarBogie::set_state_vector(self, v)
+    }
+    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
+        HalfCarBogie::beyond_bounds(self)
+    }
+    fn clone_box(&self) -> Box<dyn RailVehicle> {
+        Box::new(self.clone())
+    }
+}
+
+impl SprungVehicle for SprungHalfCar {
+    fn wheelsets(&self) -> usize {
+        2
+    }
+    fn critical_time_step(&self) -> f64 {
+        self.params().critical_time_step()
+    }
+    fn side_frames(&self) -> (Axles, Axles) {
+        let (z, v) = SprungHalfCar::side_frames(self);
+        (axles(z), axles(v))
+    }
+    fn bodies(&self, z: &Axles) -> Option<Bodies> {
+        let mut d = self.params().static_state(pair(z))?;
+        d.fixed_rows_mut::<6>(0).copy_from(self.displacements());
+        Some(half_car_bodies(&d))
+    }
+    fn step(&mut self, f: &Axles) {
+        SprungHalfCar::step(self, pair(f))
+    }
+    fn set_static(&mut self, z: &Axles) -> Result<Axles> {
+        SprungHalfCar::set_static(self, pair(z)).map(axles)
+    }
+    fn change_dt(&mut self, dt: f64) -> Result<()> {
+        SprungHalfCar::change_dt(self, dt)
+    }
+    fn state_vector(&self) -> Vec<f64> {
+        SprungHalfCar::state_vector(self)
+    }
+    fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
+        SprungHalfCar::set_state_vector(self, v)
+    }
+    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
+        SprungHalfCar::beyond_bounds(self)
+    }
+    fn exchange_limits(&self, z: &Axles, base: f64, support: f64) -> Result<ExchangeLimits> {
+        SprungHalfCar::exchange_limits(self, pair(z), base, support)
+    }
+    fn clone_box(&self) -> Box<dyn SprungVehicle> {
+        Box::new(self.clone())
+    }
+}
