@@ -22,7 +22,7 @@ VENV = os.path.join(ROOT, ".venv")
 REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
 FMU_DIR = os.path.join(ROOT, "fmu") if CHECKOUT else \
     os.path.join(os.path.dirname(os.path.abspath(__file__)), "wheelflat_study", "_data", "fmu")
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")
+FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
 # Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
 
@@ -310,103 +310,148 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
 HEIGHTS = ("static_wheel_z.left", "static_wheel_z.right")
 
 
-def half_car_handshake(track, bogie, track_params, bogie_params):
-    """Parameters and the static handshake of TrackContact carrying two wheelsets with
-    the HalfCarBogie: the bogie's static loads to the track, both wheelsets' static
-    wheel heights back; both left in initialization mode. TrackContact's
-    ``wheelset[2].offset`` is set to the bogie's ``vehicle.wheelbase``."""
-    bp = dict(bogie_params or {})
-    tp = dict(track_params or {}, wheelsets=2)
-    for u in (track, bogie):
+def carrier_handshake(track, vehicle, n, track_params, vehicle_params):
+    """Parameters and the static handshake of TrackContact carrying the `n` wheelsets of
+    a vehicle on several wheelsets (HalfCarBogie: 2, Wagon: 4): its static loads to the
+    track, every wheelset's static wheel heights back; both left in initialization
+    mode. TrackContact's offsets are the vehicle's: ``wheelset[2].offset`` its
+    ``vehicle.wheelbase``, and for the Wagon ``wheelset[3].offset`` its
+    ``vehicle.bogie_distance`` and ``wheelset[4].offset`` their sum."""
+    vp = dict(vehicle_params or {})
+    tp = dict(track_params or {}, wheelsets=n)
+    for u in (track, vehicle):
         u.fmu.setupExperiment(startTime=0.0)
-    bogie.set_parameters(bp)
-    start = {v.name: v.start for v in bogie.md.modelVariables}
-    tp["wheelset[2].offset"] = float(bp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
+    vehicle.set_parameters(vp)
+    start = {v.name: v.start for v in vehicle.md.modelVariables}
+    a = float(vp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
+    tp["wheelset[2].offset"] = a
+    if n == 4:
+        d = float(vp.get("vehicle.bogie_distance", start["vehicle.bogie_distance"]))
+        tp["wheelset[3].offset"] = d
+        tp["wheelset[4].offset"] = d + a
     track.set_parameters(tp)
-    bogie.fmu.enterInitializationMode()
+    vehicle.fmu.enterInitializationMode()
     track.fmu.enterInitializationMode()
     loads = ("static_load.left", "static_load.right")
-    track.set(loads, bogie.get(*loads))
-    for names in (HEIGHTS, trailing(2, HEIGHTS)):
-        bogie.set(names, track.get(*names))
+    track.set(loads, vehicle.get(*loads))
+    vehicle.set(HEIGHTS, track.get(*HEIGHTS))
+    for k in range(2, n + 1):
+        names = trailing(k, HEIGHTS)
+        vehicle.set(names, track.get(*names))
 
 
-def run_half_car(paths, stop_time, track_params=None, bogie_params=None, record=None):
-    """Couples TrackContact (two wheelsets) and HalfCarBogie at the contact, at the
-    track's internal step: per communication point both wheelsets' wheel heights and
-    axle rotations to the track, its four contact forces back, both step. This is
-    CoupledSystem with ``vehicle.model`` = half_car, exchanged at every step. Returns
-    the largest contact forces ``[[left, right] of wheelset 1, of wheelset 2]`` (N);
-    ``record``, a list, receives ``[time, the four contact forces]`` at every point."""
+def half_car_handshake(track, bogie, track_params, bogie_params):
+    """:func:`carrier_handshake` of the HalfCarBogie (two wheelsets)."""
+    carrier_handshake(track, bogie, 2, track_params, bogie_params)
+
+
+def every_wheelset(n, names):
+    """`names` of the leading wheelset, then of wheelsets 2 to `n`."""
+    out = list(names)
+    for k in range(2, n + 1):
+        out += trailing(k, names)
+    return out
+
+
+def run_carrier(paths, model, n, stop_time, track_params=None, vehicle_params=None, record=None):
+    """Couples TrackContact (`n` wheelsets) and the vehicle FMU `model` on them
+    (HalfCarBogie: 2, Wagon: 4) at the contact, at the track's internal step: per
+    communication point every wheelset's wheel heights and axle rotation to the track,
+    its contact forces back, both step. This is CoupledSystem with ``vehicle.model`` =
+    half_car or wagon, exchanged at every step. Returns the largest contact forces
+    ``[[left, right] of each wheelset]`` (N); ``record``, a list, receives ``[time, the
+    contact forces]`` at every point."""
     track = Unit(paths["TrackContact"], "track")
-    bogie = Unit(paths["HalfCarBogie"], "bogie")
-    wheels = WHEELS + trailing(2, WHEELS)
-    forces = FORCES + trailing(2, FORCES)
+    vehicle = Unit(paths[model], "vehicle")
+    wheels = every_wheelset(n, WHEELS)
+    forces = every_wheelset(n, FORCES)
     try:
-        half_car_handshake(track, bogie, track_params, bogie_params)
-        track.set(wheels, bogie.get(*wheels))
-        bogie.set(forces, track.get(*forces))
-        bogie.fmu.exitInitializationMode()
+        carrier_handshake(track, vehicle, n, track_params, vehicle_params)
+        track.set(wheels, vehicle.get(*wheels))
+        vehicle.set(forces, track.get(*forces))
+        vehicle.fmu.exitInitializationMode()
         track.fmu.exitInitializationMode()
         h = track.get("solver.step")[0]
-        n = int(round(stop_time / h))
-        peak = [[-1e300] * 2, [-1e300] * 2]
+        steps = int(round(stop_time / h))
+        peak = [[-1e300] * 2 for _ in range(n)]
         t = 0.0
-        for k in range(n + 1):
-            track.set(wheels, bogie.get(*wheels))
+        for k in range(steps + 1):
+            track.set(wheels, vehicle.get(*wheels))
             p = track.get(*forces)
-            bogie.set(forces, p)
-            for i in range(4):
+            vehicle.set(forces, p)
+            for i in range(2 * n):
                 peak[i // 2][i % 2] = max(peak[i // 2][i % 2], p[i])
             if record is not None:
                 record.append([t] + p)
-            if k == n:
+            if k == steps:
                 break
             track.fmu.doStep(t, h)
-            bogie.fmu.doStep(t, h)
+            vehicle.fmu.doStep(t, h)
             t = (k + 1) * h
         return peak
     finally:
         track.close()
-        bogie.close()
+        vehicle.close()
+
+
+def run_half_car(paths, stop_time, track_params=None, bogie_params=None, record=None):
+    """:func:`run_carrier` of the HalfCarBogie: CoupledSystem with ``vehicle.model`` =
+    half_car, exchanged at every step."""
+    return run_carrier(paths, "HalfCarBogie", 2, stop_time, track_params, bogie_params, record)
+
+
+def run_wagon(paths, stop_time, track_params=None, wagon_params=None, record=None):
+    """:func:`run_carrier` of the Wagon (four wheelsets): CoupledSystem with
+    ``vehicle.model`` = wagon, exchanged at every step."""
+    return run_carrier(paths, "Wagon", 4, stop_time, track_params, wagon_params, record)
+
+
+def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None,
+                         record=None):
+    """Couples TrackContact (`n` wheelsets) and the vehicle FMU `model` at the axle
+    boxes (``interface`` = axle_box): the track carries every wheelset with its primary
+    suspension, the vehicle the bodies above. Per communication step the side frames'
+    motion above each axle box to the track, the track steps, its mean primary forces
+    back, the vehicle steps (track first). Returns the largest contact forces
+    ``[[left, right] of each wheelset]`` (N) over the run; ``record``, a list, receives
+    ``[time, the contact forces]`` at every communication point."""
+    track = Unit(paths["TrackContact"], "track")
+    vehicle = Unit(paths[model], "vehicle")
+    frames = every_wheelset(n, FRAMES)
+    primary = every_wheelset(n, PRIMARY)
+    axle_box = every_wheelset(n, AXLE_BOX)
+    forces = every_wheelset(n, FORCES)
+    try:
+        # vehicle.model = half_car or wagon: the track carries the bogies' pitching side
+        # frames, each shared by two wheelsets, over each step.
+        carrier_handshake(track, vehicle, n, dict(track_params or {}, interface=2, **{"vehicle.model": n // 2 + 1}),
+                          dict(vehicle_params or {}, interface=2))
+        vehicle.fmu.exitInitializationMode()
+        track.fmu.exitInitializationMode()
+        steps = int(round(stop_time / comm_step))
+        for k in range(steps):
+            t = k * comm_step
+            track.set(frames, vehicle.get(*frames))
+            track.fmu.doStep(t, comm_step)
+            vehicle.set(axle_box, track.get(*primary))
+            vehicle.fmu.doStep(t, comm_step)
+            if record is not None:
+                record.append([t + comm_step] + track.get(*forces))
+        m = track.get(*every_wheelset(n, ("contact.left.max_force", "contact.right.max_force")))
+        return [m[2 * i:2 * i + 2] for i in range(n)]
+    finally:
+        track.close()
+        vehicle.close()
 
 
 def run_half_car_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, bogie_params=None, record=None):
-    """Couples TrackContact (two wheelsets) and HalfCarBogie at the axle boxes
-    (``interface`` = axle_box): the track carries both wheelsets with their primary
-    suspensions, the bogie the bodies above. Per communication step the side frames'
-    motion above each axle box to the track, the track steps, its mean primary forces
-    back, the bogie steps (track first). Returns the largest contact forces ``[[left,
-    right] of wheelset 1, of wheelset 2]`` (N) over the run; ``record``, a list,
-    receives ``[time, the four contact forces]`` at every communication point."""
-    track = Unit(paths["TrackContact"], "track")
-    bogie = Unit(paths["HalfCarBogie"], "bogie")
-    frames = FRAMES + trailing(2, FRAMES)
-    primary = PRIMARY + trailing(2, PRIMARY)
-    axle_box = AXLE_BOX + trailing(2, AXLE_BOX)
-    forces = FORCES + trailing(2, FORCES)
-    try:
-        # vehicle.model = half_car: the track carries the bogie's pitching side frames,
-        # shared by the two wheelsets, over each step.
-        half_car_handshake(track, bogie, dict(track_params or {}, interface=2, **{"vehicle.model": 2}),
-                           dict(bogie_params or {}, interface=2))
-        bogie.fmu.exitInitializationMode()
-        track.fmu.exitInitializationMode()
-        n = int(round(stop_time / comm_step))
-        for k in range(n):
-            t = k * comm_step
-            track.set(frames, bogie.get(*frames))
-            track.fmu.doStep(t, comm_step)
-            bogie.set(axle_box, track.get(*primary))
-            bogie.fmu.doStep(t, comm_step)
-            if record is not None:
-                record.append([t + comm_step] + track.get(*forces))
-        m = track.get("contact.left.max_force", "contact.right.max_force",
-                      *trailing(2, ("contact.left.max_force", "contact.right.max_force")))
-        return [m[:2], m[2:]]
-    finally:
-        track.close()
-        bogie.close()
+    """:func:`run_carrier_axle_box` of the HalfCarBogie."""
+    return run_carrier_axle_box(paths, "HalfCarBogie", 2, stop_time, comm_step, track_params, bogie_params, record)
+
+
+def run_wagon_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, wagon_params=None, record=None):
+    """:func:`run_carrier_axle_box` of the Wagon (four wheelsets)."""
+    return run_carrier_axle_box(paths, "Wagon", 4, stop_time, comm_step, track_params, wagon_params, record)
 
 
 if __name__ == "__main__":

@@ -13,7 +13,8 @@ use crate::contact::ContactModel;
 use crate::track::RailProfile;
 use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
 use crate::vehicle::{
-    HalfCarParams, LumpedTrackParams, WagonParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
+    HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
+    WagonParams,
 };
 use crate::wheel::{FlatSpec, OutOfRoundness};
 use std::sync::Arc;

@@ -190,8 +190,12 @@ impl VehicleUnit {
         let (whole, sprung): (Option<Box<dyn RailVehicle>>, Option<Box<dyn SprungVehicle>>) =
             match (&p.model, p.axle_box) {
                 (UnitModel::RollPlane, _) => (None, None),
-                (UnitModel::HalfCar(h), false) => (Some(Box::new(HalfCarBogie::new(*h, dt)?)), None),
-                (UnitModel::HalfCar(h), true) => (None, Some(Box::new(SprungHalfCar::new(*h, dt)?))),
+                (UnitModel::HalfCar(h), false) => {
+                    (Some(Box::new(HalfCarBogie::new(*h, dt)?)), None)
+                }
+                (UnitModel::HalfCar(h), true) => {
+                    (None, Some(Box::new(SprungHalfCar::new(*h, dt)?)))
+                }
                 (UnitModel::Wagon(w), false) => (Some(Box::new(Wagon::new(*w, dt)?)), None),
                 (UnitModel::Wagon(w), true) => (None, Some(Box::new(SprungWagon::new(*w, dt)?))),
             };

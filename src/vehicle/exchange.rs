@@ -16,10 +16,8 @@
 //! and dampers. Measured against the whole model on the track
 //! (`examples/axle_box_masters.rs --limits`) it is in docs/VALIDATION.md.
 
-use super::rail_vehicle::{Axles, SprungVehicle};
 use super::{
-    HalfCarParams, PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie,
-    SprungHalfCar, SprungWagon, WagonParams,
+    HalfCarParams, PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie, SprungHalfCar,
 };
 use crate::error::Result;
 use nalgebra::DMatrix;
@@ -371,44 +369,4 @@ fn wheelset_of(h: &HalfCarParams) -> RollPlaneParams {
         secondary_spacing: 0.0,
         gravity: h.gravity,
     }
-}
-
-impl SprungBody for SprungWagon {
-    fn boxes(&self) -> usize {
-        8
-    }
-    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
-        let (z, v) = SprungVehicle::side_frames(self);
-        (z.concat(), v.concat())
-    }
-    fn step_boxes(&mut self, f: &[f64]) {
-        let a: Axles = [0, 1, 2, 3].map(|w| [f[2 * w], f[2 * w + 1]]);
-        SprungVehicle::step(self, &a);
-    }
-    fn state(&self) -> Vec<f64> {
-        SprungVehicle::state_vector(self)
-    }
-    fn set_state(&mut self, v: &[f64]) {
-        let _ = SprungVehicle::set_state_vector(self, v);
-    }
-    fn set_step(&mut self, dt: f64) {
-        let _ = SprungVehicle::change_dt(self, dt);
-    }
-}
-
-/// [`ExchangeLimits`] of the wagon above its primary suspensions `body` (of `p`) at rest
-/// with its axle boxes at `z_box` (m), as [`SprungHalfCar::exchange_limits`]: each
-/// bogie's pitching side frames shared by its two wheelsets.
-///
-/// Errors: a parameter [`PrimaryLink::new`] refuses.
-pub(super) fn wagon_limits(
-    body: &SprungWagon,
-    p: &WagonParams,
-    z_box: &Axles,
-    base: f64,
-    support: f64,
-) -> Result<ExchangeLimits> {
-    let h = &p.bogie;
-    let track = track_side(body, &wheelset_of(h), pitching(h), &z_box.concat(), support)?;
-    Ok(limits_of(body, &track, base))
 }

@@ -44,8 +44,8 @@ pub use half_car::{
 };
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
+pub use rail_vehicle::{Axles, Bodies, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
-pub use rail_vehicle::{Axles, Bodies, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
 pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};

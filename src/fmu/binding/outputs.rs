@@ -145,7 +145,10 @@ impl FmuModel {
         let frames = || match view {
             View::Vehicle(u) => u.side_frames_of(index),
             View::Sim(sim, _) => {
-                match (sim.carrier(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                match (
+                    sim.carrier(),
+                    sim.wheelsets().get(index).map(|w| w.vehicle()),
+                ) {
                     (Some(b), _) => {
                         let (z, v) = b.side_frames();
                         Some((z[w], v[w]))
@@ -164,7 +167,10 @@ impl FmuModel {
         let bearing = || match view {
             View::Vehicle(u) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
             View::Sim(sim, _) => {
-                match (sim.carrier(), sim.wheelsets().get(index).map(|w| w.vehicle())) {
+                match (
+                    sim.carrier(),
+                    sim.wheelsets().get(index).map(|w| w.vehicle()),
+                ) {
                     (Some(b), _) => b.bearing_forces()[w][side],
                     (None, Some(VehicleState::RollPlane(v))) => v.bearing_forces()[side],
                     (None, Some(VehicleState::AxleBox(link))) => link.force_now()[side],

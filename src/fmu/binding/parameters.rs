@@ -8,10 +8,10 @@ use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
 use crate::numerics::Table;
-use crate::sim::{UnitModel, VehicleUnitParams};
 use crate::sim::{
     Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
+use crate::sim::{UnitModel, VehicleUnitParams};
 use crate::track::{
     RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
     TrackParams,
