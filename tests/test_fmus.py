@@ -35,7 +35,7 @@ fmi2GetStringStatus""".split()
 @pytest.fixture(scope="session")
 def paths():
     p = {n: os.path.join(wf.FMU_DIR, n + ".fmu")
-         for n in ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")}
+         for n in ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")}
     if not all(os.path.exists(x) for x in p.values()):
         p = wf.build_fmus()
     return p
@@ -77,7 +77,7 @@ def initialised(paths, name, log=None, params=None):
 
 # ------------------------------------------------------------------ model descriptions and header
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon"])
 def test_fmpy_validate_reports_nothing(paths, name):
     assert validate_fmu(paths[name]) == []
 
@@ -144,7 +144,7 @@ class HtmlTables(html.parser.HTMLParser):
             self.cell += data
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon"])
 def test_documentation_lists_every_variable_with_its_unit(paths, name):
     from fmpy import read_model_description
     with zipfile.ZipFile(paths[name]) as z:
@@ -512,7 +512,7 @@ def test_wrong_guid_is_refused(paths):
     assert "matches none of" in log.text()
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon"])
 def test_each_fmu_binary_instantiates_only_its_own_guid(paths, name):
     """The three FMUs carry the same library; inside an FMU it is named after the model
     identifier, and takes only that FMU's GUID."""
@@ -580,16 +580,18 @@ def test_reset_then_rerun_gives_identical_results(paths):
     assert max(x[0] for x in a) > 200e3
 
 
-@pytest.mark.parametrize("name", ["CoupledSystem", "TrackContact", "RollPlaneVehicle", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["CoupledSystem", "TrackContact", "RollPlaneVehicle", "HalfCarBogie", "Wagon"])
 def test_state_restore_and_serialisation_continue_bit_identically(paths, name):
     u = initialised(paths, name)
     inputs = {"TrackContact": ("wheel.left.z", -1.3e-3), "RollPlaneVehicle": ("contact.left.force", 150e3),
-              "HalfCarBogie": ("wheelset[2].contact.left.force", 150e3), "CoupledSystem": None}[name]
+              "HalfCarBogie": ("wheelset[2].contact.left.force", 150e3),
+              "Wagon": ("wheelset[4].contact.left.force", 150e3), "CoupledSystem": None}[name]
     if inputs:
         u.set([inputs[0]], [inputs[1]])
     outs = {"TrackContact": ("contact.left.force", "rail.left.z"),
             "RollPlaneVehicle": ("wheel.left.z", "bolster.z"),
             "HalfCarBogie": ("wheelset[2].wheel.left.z", "sideframe.left.pitch"),
+            "Wagon": ("wheelset[4].wheel.left.z", "carbody.pitch"),
             "CoupledSystem": ("contact.left.force", "wheel.right.z")}[name]
     run_for(u, 0.0, 1500, names=outs)  # into the first impact
     t = 1500 * 2e-5
@@ -1238,7 +1240,7 @@ def test_a_braked_pair_keeps_its_flats_where_the_track_carries_the_wheels(paths)
     assert "wheel.rotation turned by" in text and "give the vehicle the speed the track has" in text, text
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon"])
 def test_model_descriptions_declare_the_units_they_use_and_a_license(paths, name):
     import xml.etree.ElementTree as ET
     with zipfile.ZipFile(paths[name]) as z:
@@ -1258,7 +1260,7 @@ def test_setup_experiment_logs_no_undefined_stop_time(paths):
     u.close(terminate=False)
 
 
-@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon"])
 def test_each_fmu_carries_its_icon(paths, name):
     import io
     import matplotlib.image as mpimg
@@ -1375,7 +1377,7 @@ def test_every_fmu_instantiates_with_the_libraries_loaded_rtld_global(paths):
     assert lines[4] == "bad []", r.stdout
 
 
-@pytest.mark.parametrize("name", ["RollPlaneVehicle", "HalfCarBogie"])
+@pytest.mark.parametrize("name", ["RollPlaneVehicle", "HalfCarBogie", "Wagon"])
 def test_every_real_output_of_the_vehicles_has_its_first_derivative(paths, name):
     # Issue 25: maxOutputDerivativeOrder = 1 is declared without restriction, so every
     # Real output answers: the rate over the next substep under the held inputs, which a

@@ -27,7 +27,7 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FMU_DIR = os.path.join(ROOT, "fmu")
 SYSTEMS = os.path.join(FMU_DIR, "systems")
-VEHICLES = {"RollPlaneVehicle": 1, "HalfCarBogie": 2}
+VEHICLES = {"RollPlaneVehicle": 1, "HalfCarBogie": 2, "Wagon": 4}
 STOP = 0.6
 # The first impact is at about 34 ms; the start is checked before it.
 EARLY = 0.02
@@ -40,7 +40,7 @@ def system_name(vehicle, interface):
 def wheel_names(n, what):
     """`contact.<side>.<what>` of the n wheelsets' wheels, TrackContact's names."""
     names = [f"contact.{s}.{what}" for s in ("left", "right")]
-    return names + [f"wheelset[2].{x}" for x in names] if n == 2 else names
+    return names + [f"wheelset[{k}].{x}" for k in range(2, n + 1) for x in names]
 
 
 def shipped_step(vehicle, interface):
@@ -212,9 +212,12 @@ def monolithic_start(vehicle, h):
 
 
 def coupled_params(n):
-    p = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "vehicle.model": n}
-    if n == 2:
-        p.update({"wheelsets": 2, "wheelset[2].offset": 1.8})
+    # vehicle.model: 1 roll_plane, 2 half_car, 3 wagon.
+    p = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "vehicle.model": {1: 1, 2: 2, 4: 3}[n]}
+    if n >= 2:
+        p.update({"wheelsets": n, "wheelset[2].offset": 1.8})
+    if n == 4:
+        p.update({"wheelset[3].offset": 10.0, "wheelset[4].offset": 11.8})
     return p
 
 
