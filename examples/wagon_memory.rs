@@ -3,9 +3,12 @@
 //! converged grid and the default window, 60 s at 70 km/h: the peak resident memory
 //! (VmHWM) and the wall time at 1, 10 and 60 s of simulated time. Memory stays constant
 //! because the window moves with the wagon. Linux only (reads /proc/self/status).
-//! `cargo run --release --example wagon_memory`
+//! The wagon is the whole car body on two half-car bogies (`vehicle.model = wagon`);
+//! with the argument `roll_plane`, a roll-plane vehicle on each wheelset.
+//! `cargo run --release --example wagon_memory [roll_plane]`
 use std::time::Instant;
-use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec};
+use wheelflat::vehicle::WagonParams;
 
 fn peak_rss_kib() -> u64 {
     let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -25,6 +28,12 @@ fn main() {
             ..Default::default()
         })
         .collect();
+    if std::env::args().nth(1).as_deref() != Some("roll_plane") {
+        let VehicleSpec::RollPlane(p) = s.vehicle else {
+            unreachable!("the preset has the roll-plane vehicle")
+        };
+        s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
+    }
     let before = peak_rss_kib();
     let mut sim = Simulation::new(&s).unwrap();
     println!(
@@ -32,7 +41,7 @@ fn main() {
         sim.rail_nodes() / 2 / 8
     );
     println!(
-        "| simulated (s) | position (m) | peak RSS (KiB) | wall (s) | largest force, leading / rear wheelset of the front bogie (kN) |"
+        "| simulated (s) | position (m) | peak RSS (KiB) | wall (s) | largest force of each wheelset's left wheel (kN) |"
     );
     println!("|---|---|---|---|---|");
     let t0 = Instant::now();
@@ -42,12 +51,21 @@ fn main() {
         done = mark;
         let w = sim.wheelsets();
         println!(
-            "| {mark} | {:.1} | {} | {:.2} | {:.1} / {:.1} |",
+            "| {mark} | {:.1} | {} | {:.2} | {} |",
             sim.position(),
             peak_rss_kib(),
             t0.elapsed().as_secs_f64(),
-            w.get(0).unwrap().max_force()[0] / 1e3,
-            w.get(1).unwrap().max_force()[0] / 1e3
+            (0..4)
+                .map(|k| format!("{:.1}", w.get(k).unwrap().max_force()[0] / 1e3))
+                .collect::<Vec<_>>()
+                .join(" / ")
         );
+    }
+    println!("\nlargest contact forces over the run (kN):\n");
+    println!("| wheelset | left | right |");
+    println!("|---|---|---|");
+    for (k, w) in sim.wheelsets().iter().enumerate() {
+        let m = w.max_force();
+        println!("| {} | {:.1} | {:.1} |", k + 1, m[0] / 1e3, m[1] / 1e3);
     }
 }

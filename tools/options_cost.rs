@@ -5,15 +5,20 @@
 //! (pads 20 kN, ballast 1.7 kN preloads), `voids` (three hanging sleepers, 0.3 mm, at
 //! 8 m), `profile` (a measured left rail, 2 mm dip in a 1,001-point table), `weld`
 //! (the dipped weld of rail.defect.*), `roundness` (a 629-point out-of-roundness on the
-//! left wheel). Without valgrind it prints the wall time per step.
+//! left wheel), `half_car` (the half-car bogie on two wheelsets, endless track),
+//! `wagon` (the wagon on four, endless track). Without valgrind it prints the wall
+//! time per step.
 
 use std::f64::consts::TAU;
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
 use wheelflat::numerics::Table;
-use wheelflat::sim::{Scenario, Simulation, VoidedSleepers};
+use wheelflat::sim::{
+    Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
+};
 use wheelflat::track::{RailDefect, SupportLaw, Supports};
+use wheelflat::vehicle::{HalfCarParams, WagonParams};
 use wheelflat::wheel::OutOfRoundness;
 
 fn main() {
@@ -66,6 +71,30 @@ fn main() {
             s.roundness[0] = Some(Arc::new(
                 OutOfRoundness::new(Table::new(b, r, "w").unwrap(), "w").unwrap(),
             ));
+        }
+        "half_car" => {
+            let VehicleSpec::RollPlane(p) = s.vehicle else {
+                unreachable!()
+            };
+            s.vehicle = VehicleSpec::HalfCar(HalfCarParams::from_roll_plane(&p, 1.8, 180.0));
+            s.trailing = vec![TrailingWheelset {
+                offset: 1.8,
+                ..Default::default()
+            }];
+            s.window = Some(TrackWindow::DEFAULT);
+        }
+        "wagon" => {
+            let VehicleSpec::RollPlane(p) = s.vehicle else {
+                unreachable!()
+            };
+            s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
+            s.trailing = [1.8, 10.0, 11.8]
+                .map(|offset| TrailingWheelset {
+                    offset,
+                    ..Default::default()
+                })
+                .to_vec();
+            s.window = Some(TrackWindow::DEFAULT);
         }
         other => panic!("unknown option {other}"),
     }

@@ -15,9 +15,7 @@ use crate::error::{Error, Result, finite, non_negative, num, out_of_range, posit
 use crate::limits::{MAX_WHEELSETS, MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
-use crate::vehicle::{
-    HalfCarBogie, LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle, Wagon,
-};
+use crate::vehicle::{LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
 /// The contact stiffness passed to the track's stability limit is this many times the
@@ -150,23 +148,15 @@ impl Simulation {
     /// wheel load; a static state beyond the health bounds.
     pub fn new(scenario: &Scenario) -> Result<Self> {
         let s = scenario;
-        // The half-car bogie's wheelbase is the second wheelset's offset here: a refusal
-        // names that, the variable a user of the scenario (CoupledSystem) sets.
-        if let VehicleSpec::HalfCar(p) = &s.vehicle {
-            p.validate().map_err(|e| {
+        // A bogie's wheelbase and the wagon's bogie distance are the wheelsets' offsets
+        // here: a refusal names those, the variables a user of the scenario
+        // (CoupledSystem) sets.
+        if let Some(c) = s.vehicle.carrier() {
+            c.validate().map_err(|e| {
                 e.renamed(
                     "vehicle.wheelbase",
                     "wheelset[2].offset",
-                    "(the half-car bogie's wheelbase)",
-                )
-            })?;
-        }
-        if let VehicleSpec::Wagon(p) = &s.vehicle {
-            p.validate().map_err(|e| {
-                e.renamed(
-                    "vehicle.wheelbase",
-                    "wheelset[2].offset",
-                    "(the wagon's bogies' wheelbase)",
+                    "(the bogies' wheelbase)",
                 )
                 .renamed(
                     "vehicle.bogie_distance",
@@ -256,15 +246,16 @@ impl Simulation {
                 VehicleSpec::AxleBox { vehicle, .. } => VehicleState::AxleBox(
                     crate::vehicle::PrimaryLink::new(vehicle, dt, frame_inertia)?,
                 ),
-                VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
-                    VehicleState::OnBogie { wheel_z: [0.0; 2] }
-                }
                 VehicleSpec::External { .. } => VehicleState::External {
                     wheel_z: [0.0; 2],
                     rotation: 0.0,
                     since: 0.0,
                     rates: InputRates::default(),
                 },
+                // A vehicle on several wheelsets ([`VehicleSpec::carrier`]) moves them.
+                VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
+                    VehicleState::OnBogie { wheel_z: [0.0; 2] }
+                }
             })
         };
         let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?
@@ -398,22 +389,12 @@ impl Simulation {
 ///
 /// Errors: another number of wheelsets (named `wheelsets`), an offset other than the
 /// vehicle's (named `wheelset[k].offset`), the vehicle's own refusals
-/// ([`HalfCarBogie::new`], [`Wagon::new`]).
+/// ([`crate::vehicle::CarrierModel::whole`]).
 fn carrier_on(s: &Scenario, dt: f64) -> Result<Option<Box<dyn RailVehicle>>> {
-    let (offsets, what): (Vec<f64>, &str) = match &s.vehicle {
-        VehicleSpec::HalfCar(p) => (
-            vec![p.wheelbase],
-            "the half-car bogie (vehicle.model = half_car): its two wheelsets",
-        ),
-        VehicleSpec::Wagon(p) => {
-            let (a, d) = (p.bogie.wheelbase, p.bogie_distance);
-            (
-                vec![a, d, d + a],
-                "the wagon (vehicle.model = wagon): its two bogies' wheelsets",
-            )
-        }
-        _ => return Ok(None),
+    let Some(c) = s.vehicle.carrier() else {
+        return Ok(None);
     };
+    let (offsets, what) = (c.offsets(), c.name());
     if s.trailing.len() != offsets.len() {
         return Err(out_of_range(
             "wheelsets",
@@ -430,9 +411,5 @@ fn carrier_on(s: &Scenario, dt: f64) -> Result<Option<Box<dyn RailVehicle>>> {
             ));
         }
     }
-    Ok(Some(match &s.vehicle {
-        VehicleSpec::HalfCar(p) => Box::new(HalfCarBogie::new(*p, dt)?),
-        VehicleSpec::Wagon(p) => Box::new(Wagon::new(*p, dt)?),
-        _ => return Ok(None),
-    }))
+    c.whole(dt).map(Some)
 }

@@ -73,6 +73,19 @@ pub enum VehicleSpec {
     },
 }
 
+impl VehicleSpec {
+    /// The vehicle on several wheelsets, behind its interface; `None` for a vehicle or
+    /// load on each wheelset. The one place that names those kinds: a new one is an arm
+    /// here and its [`crate::vehicle::CarrierModel`] in its own file.
+    pub fn carrier(&self) -> Option<&dyn crate::vehicle::CarrierModel> {
+        match self {
+            VehicleSpec::HalfCar(h) => Some(h),
+            VehicleSpec::Wagon(w) => Some(w),
+            _ => None,
+        }
+    }
+}
+
 /// A complete simulation set-up.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {

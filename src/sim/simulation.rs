@@ -16,7 +16,7 @@ use crate::error::{Error, Result, non_negative, num};
 use crate::limits::{DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, within};
 use crate::sim::{Scenario, VoidedSleepers};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track};
-use crate::vehicle::{Axles, LumpedTrack, RailVehicle};
+use crate::vehicle::{Axles, LumpedTrack, MAX_AXLES, RailVehicle};
 
 /// Track state of a simulation.
 // Not boxed: the variant is touched every step and there is one per simulation.
@@ -504,9 +504,11 @@ impl Simulation {
     /// its wheelsets' samples at `t_j`, then moves their wheels.
     #[inline(never)]
     fn step_carrier(&mut self) {
-        let p: Axles =
-            std::array::from_fn(|k| self.wheelsets.get(k).map_or([0.0; 2], Wheelset::forces));
         if let Some(b) = &mut self.carrier {
+            let mut p: Axles = [[0.0; 2]; MAX_AXLES];
+            for (pk, w) in p.iter_mut().zip(self.wheelsets.iter()).take(b.wheelsets()) {
+                *pk = w.forces();
+            }
             b.step(&p);
         }
         self.sync_carrier_wheels();

@@ -19,8 +19,10 @@ use crate::wheel::WheelProfile;
 pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
         VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
-        VehicleSpec::HalfCar(p) => [p.static_wheel_load(); 2],
-        VehicleSpec::Wagon(p) => [p.static_wheel_load(); 2],
+        VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
+            let c = vehicle.carrier().expect("a vehicle on several wheelsets");
+            [c.static_wheel_load(); 2]
+        }
         VehicleSpec::AxleBox { static_load, .. } => {
             non_negative("static_load.left", static_load[0], "N")?;
             non_negative("static_load.right", static_load[1], "N")?;

@@ -13,9 +13,8 @@ use super::clock::{Clock, ForceExtremes, StepPlan, Stepping};
 use crate::error::{Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{MAX_VEHICLE_STEPS_PER_CALL, MIN_DT_FRACTION, check};
 use crate::vehicle::{
-    Axles, Bodies, CONTACT_STIFFNESS, ExchangeLimits, HalfCarBogie, HalfCarParams, MAX_AXLES,
-    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungHalfCar, SprungVehicle,
-    SprungWagon, Wagon, WagonParams,
+    Axles, Bodies, CONTACT_STIFFNESS, CarrierModel, ExchangeLimits, HalfCarParams, MAX_AXLES,
+    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungVehicle, WagonParams,
 };
 use nalgebra::Vector6;
 
@@ -70,13 +69,20 @@ pub enum UnitModel {
 }
 
 impl UnitModel {
+    /// The vehicle on several wheelsets, behind its interface; `None` for the
+    /// roll-plane vehicle. The one place that names the kinds: a new vehicle on several
+    /// wheelsets is an arm here and its [`CarrierModel`] in its own file.
+    pub fn carrier(&self) -> Option<&dyn CarrierModel> {
+        match self {
+            UnitModel::RollPlane => None,
+            UnitModel::HalfCar(h) => Some(h),
+            UnitModel::Wagon(w) => Some(w),
+        }
+    }
+
     /// Number of wheelsets.
     pub fn wheelsets(&self) -> usize {
-        match self {
-            UnitModel::RollPlane => 1,
-            UnitModel::HalfCar(_) => 2,
-            UnitModel::Wagon(_) => 4,
-        }
+        self.carrier().map_or(1, |c| c.wheelsets())
     }
 }
 
@@ -151,15 +157,11 @@ impl VehicleUnit {
             check(&format!("wheelset[{k}].static_wheel_z.left"), z[0])?;
             check(&format!("wheelset[{k}].static_wheel_z.right"), z[1])?;
         }
-        let (critical, default_dt) = match &p.model {
-            UnitModel::RollPlane => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
-            UnitModel::HalfCar(h) => {
-                h.validate()?;
-                (h.critical_time_step(), h.default_dt())
-            }
-            UnitModel::Wagon(w) => {
-                w.validate()?;
-                (w.critical_time_step(), w.default_dt())
+        let (critical, default_dt) = match p.model.carrier() {
+            None => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
+            Some(c) => {
+                c.validate()?;
+                (c.critical_time_step(), c.default_dt())
             }
         };
         let dt = if p.dt == 0.0 { default_dt } else { p.dt };
@@ -185,31 +187,19 @@ impl VehicleUnit {
         };
         let wheels = p.static_wheels();
         let mut force = [[p.vehicle.static_wheel_load(); 2]; MAX_AXLES];
-        // The one place that knows the kinds: a vehicle on several wheelsets is a
-        // RailVehicle (whole) and a SprungVehicle (above its primary suspension).
-        let (whole, sprung): (Option<Box<dyn RailVehicle>>, Option<Box<dyn SprungVehicle>>) =
-            match (&p.model, p.axle_box) {
-                (UnitModel::RollPlane, _) => (None, None),
-                (UnitModel::HalfCar(h), false) => {
-                    (Some(Box::new(HalfCarBogie::new(*h, dt)?)), None)
-                }
-                (UnitModel::HalfCar(h), true) => {
-                    (None, Some(Box::new(SprungHalfCar::new(*h, dt)?)))
-                }
-                (UnitModel::Wagon(w), false) => (Some(Box::new(Wagon::new(*w, dt)?)), None),
-                (UnitModel::Wagon(w), true) => (None, Some(Box::new(SprungWagon::new(*w, dt)?))),
-            };
-        let body = match (whole, sprung, p.axle_box) {
-            (Some(mut b), _, _) => {
+        let body = match (p.model.carrier(), p.axle_box) {
+            (Some(c), false) => {
+                let mut b = c.whole(dt)?;
                 force = b.set_static(&wheels)?;
                 Body::Carrier(b)
             }
-            (None, Some(mut b), _) => {
+            (Some(c), true) => {
+                let mut b = c.sprung(dt)?;
                 force = b.set_static(&wheels)?;
                 Body::SprungCarrier(b)
             }
-            (None, None, false) => Body::RollPlane(roll_plane_at_rest()?),
-            (None, None, true) => {
+            (None, false) => Body::RollPlane(roll_plane_at_rest()?),
+            (None, true) => {
                 let mut b = SprungBogie::new(p.vehicle, dt)?;
                 b.set_static(p.static_wheel_z)?;
                 let rest = roll_plane_at_rest()?;
@@ -254,7 +244,10 @@ impl VehicleUnit {
     }
     /// Static load on each wheel `[left, right]` (N).
     pub fn static_load(&self) -> [f64; 2] {
-        let w = self.params.vehicle.static_wheel_load();
+        let w = match self.params.model.carrier() {
+            Some(c) => c.static_wheel_load(),
+            None => self.params.vehicle.static_wheel_load(),
+        };
         [w, w]
     }
     /// Base step (s).

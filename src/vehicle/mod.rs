@@ -44,7 +44,7 @@ pub use half_car::{
 };
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
-pub use rail_vehicle::{Axles, Bodies, MAX_AXLES, RailVehicle, SprungVehicle};
+pub use rail_vehicle::{Axles, Bodies, CarrierModel, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
 pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};

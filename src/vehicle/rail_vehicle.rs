@@ -1,9 +1,12 @@
-//! A vehicle on several wheelsets behind one interface: [`RailVehicle`], the whole
-//! vehicle under the contact forces of its wheels (the half-car bogie, the wagon), and
-//! [`SprungVehicle`], the same vehicle above its primary suspension under the primary
-//! forces at its axle boxes. The assembly (`crate::sim`) steps either without knowing
-//! which vehicle it is: a new kind implements these traits in its own file, and is
-//! built in one match arm of the scenario's vehicle.
+//! A vehicle on several wheelsets behind one interface: [`CarrierModel`], its
+//! parameters (how many wheelsets, where, its step limits and static load);
+//! [`RailVehicle`], the whole vehicle in time under the contact forces of its wheels
+//! (the half-car bogie, the wagon); and [`SprungVehicle`], the same vehicle above its
+//! primary suspension under the primary forces at its axle boxes. The assembly
+//! (`crate::sim`) builds and steps them without knowing which vehicle it is: a new kind
+//! implements these traits in its own file, and is named in one match arm of the
+//! scenario's vehicle (`crate::sim::VehicleSpec::carrier`) and one of the vehicle
+//! unit's (`crate::sim::UnitModel::carrier`).
 //!
 //! Wheelsets are numbered from the leading one (0); a value of each wheelset is
 //! `[left, right]`, in an [`Axles`] of which the first [`RailVehicle::wheelsets`] are
@@ -32,6 +35,66 @@ pub struct Bodies {
     pub sideframe_pitch: Axles,
     /// `[bounce, roll]` of each wheelset.
     pub wheelset: Axles,
+}
+
+/// The parameters of a vehicle on several wheelsets: what the assembly needs to place
+/// its wheelsets, check its step and build it in time.
+pub trait CarrierModel {
+    /// Number of wheelsets.
+    fn wheelsets(&self) -> usize;
+    /// Where the wheelsets behind the leading one are (m behind it): the half-car's
+    /// wheelbase `a`; the wagon's `a`, `d`, `d + a` (`d` its bogie distance).
+    fn offsets(&self) -> Vec<f64>;
+    /// The vehicle in words, with the value of `vehicle.model` that selects it.
+    fn name(&self) -> &'static str;
+    /// Checks every parameter, naming the variables.
+    ///
+    /// Errors: a parameter outside its physical range.
+    fn validate(&self) -> Result<()>;
+    /// Critical step of central differences on the fastest mode (s).
+    fn critical_time_step(&self) -> f64;
+    /// Default step for the vehicle on its own (s): 50 steps per shortest period.
+    fn default_dt(&self) -> f64;
+    /// Static load on each wheel (N).
+    fn static_wheel_load(&self) -> f64;
+    /// The whole vehicle at rest at zero, stepped with `dt` (s).
+    ///
+    /// Errors: a parameter refused, `dt` not positive or above the critical step.
+    fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>>;
+    /// The vehicle above its primary suspension, stepped with `dt` (s).
+    ///
+    /// Errors: as [`CarrierModel::whole`].
+    fn sprung(&self, dt: f64) -> Result<Box<dyn SprungVehicle>>;
+}
+
+impl CarrierModel for super::HalfCarParams {
+    fn wheelsets(&self) -> usize {
+        2
+    }
+    fn offsets(&self) -> Vec<f64> {
+        vec![self.wheelbase]
+    }
+    fn name(&self) -> &'static str {
+        "the half-car bogie (vehicle.model = half_car)"
+    }
+    fn validate(&self) -> Result<()> {
+        super::HalfCarParams::validate(self)
+    }
+    fn critical_time_step(&self) -> f64 {
+        super::HalfCarParams::critical_time_step(self)
+    }
+    fn default_dt(&self) -> f64 {
+        super::HalfCarParams::default_dt(self)
+    }
+    fn static_wheel_load(&self) -> f64 {
+        super::HalfCarParams::static_wheel_load(self)
+    }
+    fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
+        Ok(Box::new(HalfCarBogie::new(*self, dt)?))
+    }
+    fn sprung(&self, dt: f64) -> Result<Box<dyn SprungVehicle>> {
+        Ok(Box::new(SprungHalfCar::new(*self, dt)?))
+    }
 }
 
 /// A whole vehicle on several wheelsets, driven by the contact forces of its wheels.

@@ -98,7 +98,7 @@ impl WagonParams {
         crate::limits::check("vehicle.carbody.roll_inertia", self.carbody_roll_inertia)?;
         crate::limits::check("vehicle.bogie_distance", self.bogie_distance)?;
         let d = self.bogie_distance;
-        if !(d > self.bogie.wheelbase) {
+        if d <= self.bogie.wheelbase {
             return Err(out_of_range(
                 "vehicle.bogie_distance",
                 d,

@@ -5,7 +5,7 @@
 //! roll-plane vehicle with the damping as in (3.25), as the half-car bogie does, and
 //! both stand behind [`RailVehicle`] and [`SprungVehicle`].
 
-use super::rail_vehicle::{Axles, Bodies, RailVehicle, SprungVehicle};
+use super::rail_vehicle::{Axles, Bodies, CarrierModel, RailVehicle, SprungVehicle};
 use super::{ExchangeLimits, WAGON_DOFS, WagonParams, WagonVector, bogie_start};
 use crate::error::{Error, Result, positive};
 use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
@@ -132,6 +132,37 @@ impl WagonParams {
             b.wheelset[w] = [d[j], d[j + 1]];
         }
         b
+    }
+}
+
+impl CarrierModel for WagonParams {
+    fn wheelsets(&self) -> usize {
+        4
+    }
+    fn offsets(&self) -> Vec<f64> {
+        let (a, d) = (self.bogie.wheelbase, self.bogie_distance);
+        vec![a, d, d + a]
+    }
+    fn name(&self) -> &'static str {
+        "the wagon (vehicle.model = wagon)"
+    }
+    fn validate(&self) -> Result<()> {
+        WagonParams::validate(self)
+    }
+    fn critical_time_step(&self) -> f64 {
+        WagonParams::critical_time_step(self)
+    }
+    fn default_dt(&self) -> f64 {
+        WagonParams::default_dt(self)
+    }
+    fn static_wheel_load(&self) -> f64 {
+        WagonParams::static_wheel_load(self)
+    }
+    fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
+        Ok(Box::new(Wagon::new(*self, dt)?))
+    }
+    fn sprung(&self, dt: f64) -> Result<Box<dyn SprungVehicle>> {
+        Ok(Box::new(SprungWagon::new(*self, dt)?))
     }
 }
 
