@@ -1,6 +1,6 @@
 """Builds the wheelflat wheel from this checkout (see pyproject.toml): the Python
 package plus, under ``wheelflat_study/_data``, the case runner (``bin/wheelflat_case``),
-the four FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs and
+the five FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs and
 the git commit. cargo builds the runner and the FMUs' library first (quick when they
 are up to date); fmu/*.fmu are packed again when older than the library. The wheel is
 tagged for this platform (py3-none-linux_x86_64): it holds a native program."""
@@ -17,7 +17,7 @@ from setuptools.command.build_py import build_py
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")
+FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
 
 
 def cargo_version():

@@ -12,7 +12,7 @@ asks for; a study started again skips the cases it already has.
     wheelflat-study studies/speed_flat.toml [--scheduler ADDRESS] [--workers N]
 
 Installed from its wheel (``python/pyproject.toml``), the package carries its own case
-runner and the four FMUs (``fmu_paths()``), so a cluster's worker needs only the
+runner and the five FMUs (``fmu_paths()``), so a cluster's worker needs only the
 install. See docs/guide/studies.md and docs/STUDIES.md.
 """
 
@@ -25,8 +25,8 @@ from .run import DATA, ROOT, default_runner, installed
 
 
 def fmu_paths():
-    """The four FMUs by name (TrackContact, RollPlaneVehicle, CoupledSystem,
-    HalfCarBogie): the installed package's, or in a checkout those in fmu/ (built by
+    """The five FMUs by name (TrackContact, RollPlaneVehicle, CoupledSystem,
+    HalfCarBogie, Wagon): the installed package's, or in a checkout those in fmu/ (built by
     ``cargo build --release && target/release/build_fmus fmu``)."""
     from .buildinfo import FMUS
     where = os.path.join(DATA, "fmu") if installed() else os.path.join(ROOT, "fmu")

@@ -10,7 +10,7 @@ import subprocess
 import xml.etree.ElementTree as ET
 import zipfile
 
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie")
+FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
 
 
 def fmu_identity(path):
