@@ -30,7 +30,9 @@ use table::{TABLE, Table};
 
 fn main() {
     println!("cargo:rerun-if-changed={TABLE}");
-    println!("cargo:rerun-if-changed={}", c_header::FFI);
+    for src in c_header::FFI {
+        println!("cargo:rerun-if-changed={src}");
+    }
     println!("cargo:rerun-if-changed=build");
     let out = PathBuf::from(env::var("OUT_DIR").unwrap());
     let version = env::var("CARGO_PKG_VERSION").unwrap();
