@@ -9,6 +9,7 @@ mod clock;
 mod health;
 mod inputs;
 mod motion;
+mod presets;
 mod sampling;
 mod scenario;
 mod simulation;
@@ -18,6 +19,7 @@ mod static_start;
 #[cfg(test)]
 mod tests;
 mod unit_state;
+mod unit_step;
 mod vehicle_state;
 mod vehicle_unit;
 mod wheelset;

@@ -2,7 +2,8 @@
 //! derivatives of its contact outputs (and, at the axle boxes, its primary forces)
 //! against its inputs, and the vehicles' output derivatives (`fmi2GetRealOutputDerivatives`).
 
-use super::unit::{Engine, FRAME_VRS, FmuModel};
+use super::inputs::FRAME_VRS;
+use super::unit::{Engine, FmuModel};
 use crate::error::Error;
 use crate::fmu::fmi2::Model;
 use crate::fmu::vars::{TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, vr};

@@ -4,6 +4,7 @@
 
 mod datum;
 mod derivatives;
+mod inputs;
 mod outputs;
 mod parameters;
 mod unit;
