@@ -21,6 +21,8 @@ mod kernels;
 mod observe;
 mod params;
 mod probe;
+#[cfg(test)]
+mod reference_tests;
 mod state;
 mod static_solve;
 mod stepper;
