@@ -1,7 +1,7 @@
 //! Each FMU's documentation/index.html (build/documentation.rs) quotes the limits of
 //! `src/limits.rs` as they are: a bound changed there fails here until the page's prose
 //! (`build/pages/`) says the new number. The variables' rows are checked against the
-//! packed FMUs by `tests/test_fmus.py`.
+//! packed FMUs by `tests/test_fmu_descriptions.py`.
 
 use wheelflat::fmu::vars::FMUS;
 use wheelflat::limits::*;

@@ -56,37 +56,37 @@ MAPPED = {
         "scripts/test.sh", ["bash scripts/build_fmus_glibc228.sh fmu\n"],
         "a minute or more; the test command packs the FMUs every later test loads with it"),
     "python: vehicle.enterInitializationMode(); track.enterInitializationMode()": (
-        "tests/test_fmus.py::test_static_handshake_puts_the_pair_at_rest", ["wf.run_pair("],
+        "tests/test_fmu_coupling.py::test_static_handshake_puts_the_pair_at_rest", ["wf.run_pair("],
         "pseudo-code (value references by name) of wheelflat_fmus.static_handshake, which run_pair "
         "calls; the test runs it and checks that the pair starts at rest"),
     "python: z = vehicle.getReal(wheels); dz = vehicle.getRealOutputDerivatives(wheels, [1, 1, 1])": (
-        "tests/test_fmus.py::test_input_derivatives_reduce_the_error_at_five_and_ten_times_the_step",
+        "tests/test_fmu_derivatives.py::test_input_derivatives_reduce_the_error_at_five_and_ten_times_the_step",
         ["wf.run_pair(", "input_derivatives=derivs"],
         "pseudo-code of run_pair(..., input_derivatives=True), the loop the page names; the test "
         "runs it at 5 and 10 times the track's step"),
     "python: track.setReal(sideframe_z_and_v, bogie.side_frames())": (
-        "tests/test_fmus.py::test_a_bogie_model_at_1_ms_couples_at_the_axle_boxes_within_two_percent",
+        "tests/test_fmu_coupling.py::test_a_bogie_model_at_1_ms_couples_at_the_axle_boxes_within_two_percent",
         ["wf.run_axle_box_pair("],
         "pseudo-code for a third-party bogie model; run_axle_box_pair is that loop with "
         "RollPlaneVehicle as the bogie, which the test runs at 1 and 2 ms"),
     ".venv/bin/python -m pip wheel --no-deps --no-build-isolation -w dist python/": (
-        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        "tests/test_study_runs.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
         ['"pip", "wheel"', '"--no-deps", "--no-build-isolation"', 'os.path.join(ROOT, "python")'],
         "builds the wheel; the test builds it into a temporary folder, not the checkout's dist/"),
     "pip install dist/wheelflat-0.1.0-py3-none-linux_x86_64.whl": (
-        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        "tests/test_study_runs.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
         ['"pip", "--python", py, "install"', "wheelflat-*-py3-none-linux_*.whl"],
         "installs on a cluster's host; the test installs into a new environment, not this .venv"),
     "python -m distributed.cli.dask_scheduler --host 127.0.0.1 --port 8786 --no-dashboard &": (
-        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        "tests/test_study_runs.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
         ['"distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port"', '"--no-dashboard"'],
         "a scheduler that runs until stopped; the test starts it on a free port in an empty folder"),
     "python -m distributed.cli.dask_worker tcp://127.0.0.1:8786 --nworkers 1 --nthreads 1 --no-dashboard &": (
-        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        "tests/test_study_runs.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
         ['"distributed.cli.dask_worker", addr, "--nworkers", "1"', '"--nthreads", "1", "--no-dashboard"'],
         "a worker that runs until stopped; the test starts two, each in its own empty folder"),
     "wheelflat-study speed_flat.toml --scheduler tcp://127.0.0.1:8786": (
-        "tests/test_study.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
+        "tests/test_study_runs.py::test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout",
         ['"wheelflat-study"', '"--scheduler", addr'],
         "needs the scheduler and workers above; the test runs it from an empty folder with only the "
         "installed wheel and compares the table with a serial run bit for bit"),

@@ -1,5 +1,6 @@
 //! Tests of the FMI layer with this project's models, through the Rust API of an
-//! instance (the C boundary has its own in `tests/fmi_ffi.rs` and `tests/fmi_fuzz.rs`).
+//! instance (the C boundary has its own in `tests/fmi_ffi.rs`, `tests/fmi_threads.rs` and
+//! `tests/fmi_fuzz/`).
 
 mod bounds;
 mod clock;
