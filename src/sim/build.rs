@@ -11,8 +11,8 @@ use super::static_start::{contact_law, static_loads};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::ContactLaw;
-use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{MAX_WHEELSETS, MIN_DT_FRACTION, force_limit};
+use crate::error::{Error, Result, finite, num, out_of_range, positive};
+use crate::limits::{MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle};
@@ -134,9 +134,6 @@ pub const MAX_WINDOW_SIDE: f64 = 1000.0;
 /// is off by 0.12 % and its force history by 16 % of the static load
 /// (`examples/window_study.rs`); shorter windows are further off.
 pub const MIN_WINDOW_SIDE: f64 = 4.0;
-/// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
-/// below a step's travel (0.3 mm at 70 km/h), so positions integrate the speed.
-pub const MAX_START_POSITION: f64 = 1e7;
 
 impl Simulation {
     /// Builds the models, checks every parameter and puts the system in static
@@ -148,72 +145,7 @@ impl Simulation {
     /// wheel load; a static state beyond the health bounds.
     pub fn new(scenario: &Scenario) -> Result<Self> {
         let s = scenario;
-        // A bogie's wheelbase and the wagon's bogie distance are the wheelsets' offsets
-        // here: a refusal names those, the variables a user of the scenario
-        // (CoupledSystem) sets.
-        if let Some(c) = s.vehicle.carrier() {
-            c.validate().map_err(|e| {
-                e.renamed(
-                    "vehicle.wheelbase",
-                    "wheelset[2].offset",
-                    "(the bogies' wheelbase)",
-                )
-                .renamed(
-                    "vehicle.bogie_distance",
-                    "wheelset[3].offset",
-                    "(the wagon's bogie centre distance)",
-                )
-            })?;
-        }
-        positive("wheel.radius", s.wheel_radius, "m")?;
-        finite("speed", s.speed, "m/s")?;
-        if s.speed < 0.0 {
-            return Err(out_of_range("speed", s.speed, ">= 0 m/s"));
-        }
-        finite("start_position", s.start_position, "m")?;
-        if s.start_position.abs() > MAX_START_POSITION {
-            return Err(out_of_range(
-                "start_position",
-                s.start_position,
-                format!(
-                    "-{MAX_START_POSITION:e} m <= start_position <= {MAX_START_POSITION:e} m \
-                     (positions along the line keep 1e-9 m of resolution there)"
-                ),
-            ));
-        }
-        non_negative("solver.dt", s.dt, "s")?;
-        non_negative("contact.Kw", s.kw, "N/m/rad")?;
-        non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
-        if s.trailing.len() + 1 > MAX_WHEELSETS {
-            return Err(out_of_range(
-                "wheelsets",
-                (s.trailing.len() + 1) as f64,
-                format!("1 to {MAX_WHEELSETS} wheelsets"),
-            ));
-        }
-        for (k, w) in s.trailing.iter().enumerate() {
-            let name = format!("wheelset[{}].offset", k + 2);
-            positive(&name, w.offset, "m")?;
-            let before = if k == 0 {
-                0.0
-            } else {
-                s.trailing[k - 1].offset
-            };
-            // Wheels of the same rail cannot overlap: one wheel diameter apart at least.
-            let least = before + 2.0 * s.wheel_radius;
-            if w.offset.is_nan() || w.offset < least {
-                return Err(out_of_range(
-                    &name,
-                    w.offset,
-                    format!(
-                        ">= {} m, the wheelset ahead's offset {} m plus a wheel diameter \
-                         (wheelsets in order, the leading one first)",
-                        num(least),
-                        num(before)
-                    ),
-                ));
-            }
-        }
+        s.validate()?;
         // The contact law first: its stiffness under the largest force a run reaches
         // enters the stability limit of the track.
         let static_load = static_loads(&s.vehicle)?;

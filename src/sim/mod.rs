@@ -5,6 +5,7 @@
 
 mod accelerations;
 mod build;
+mod checks;
 mod clock;
 mod health;
 mod inputs;

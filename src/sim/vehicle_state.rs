@@ -1,6 +1,7 @@
 //! What moves the wheels of a wheelset, behind one interface: the roll-plane vehicle,
 //! the lumped wheels, constant loads, the wheelset on its primary suspension under an
-//! outside bogie, a wheelset of the half-car bogie, or wheels moved from outside.
+//! outside bogie, a wheelset of a vehicle on several wheelsets, or wheels moved from
+//! outside.
 
 use super::inputs::InputRates;
 use crate::vehicle::{LumpedWheels, RollPlaneVehicle};
@@ -19,8 +20,9 @@ pub enum VehicleState {
     /// above it outside ([`crate::vehicle::PrimaryLink`]): the side frames' motion is
     /// the input, the primary forces the output.
     AxleBox(crate::vehicle::PrimaryLink),
-    /// A wheelset of the half-car bogie ([`super::Simulation::bogie`]), which moves its
-    /// wheels: their displacements `[left, right]` (m) after the bogie's last step.
+    /// A wheelset of a vehicle on several wheelsets, the half-car bogie or the wagon
+    /// ([`super::Simulation::carrier`]), which moves its wheels: their displacements
+    /// `[left, right]` (m) after the vehicle's last step.
     OnBogie {
         /// Wheel-centre displacements `[left, right]` (m).
         wheel_z: [f64; 2],

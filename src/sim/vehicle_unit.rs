@@ -109,7 +109,7 @@ pub(super) enum Body {
 }
 
 /// A vehicle as a co-simulation unit: the six-DOF roll-plane vehicle (3.1-3.3,
-/// 3.24-3.27), the half-car bogie ([`HalfCarBogie`], two wheelsets) or the wagon
+/// 3.24-3.27), the half-car bogie ([`crate::vehicle::HalfCarBogie`], two wheelsets) or the wagon
 /// ([`crate::vehicle::Wagon`], four). The contact
 /// forces `[left, right]` (N) of each wheelset come in and are held over each
 /// communication step (with the axle-box interface, the primary forces); the

@@ -1,0 +1,95 @@
+//! A scenario that checks itself: the parameters [`Scenario`] carries that need no
+//! model built to be judged (the wheel, the speed, the start, the solver's and the
+//! contact's numbers, the wheelsets' count and order, a vehicle on several wheelsets
+//! against their offsets). [`super::Simulation::new`] calls it first; the models'
+//! own checks follow as each is built.
+
+use super::Scenario;
+use crate::error::{Result, finite, non_negative, num, out_of_range, positive};
+use crate::limits::MAX_WHEELSETS;
+
+/// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
+/// below a step's travel (0.3 mm at 70 km/h), so positions integrate the speed.
+pub(crate) const MAX_START_POSITION: f64 = 1e7;
+
+impl Scenario {
+    /// Checks the scenario's own parameters, naming each as the FMUs' variables do.
+    ///
+    /// Errors: a value outside its range ([`crate::Error::Parameter`]): a vehicle on
+    /// several wheelsets whose parameters its model refuses (its wheelbase named
+    /// `wheelset[2].offset`, the wagon's bogie distance `wheelset[3].offset`), the wheel
+    /// radius, a negative or non-finite speed, a start beyond
+    /// 1e7 m, a negative step or contact constant, more than
+    /// [`MAX_WHEELSETS`] wheelsets, or wheelsets out of order or closer than a wheel
+    /// diameter.
+    pub fn validate(&self) -> Result<()> {
+        let s = self;
+        // A bogie's wheelbase and the wagon's bogie distance are the wheelsets' offsets
+        // here: a refusal names those, the variables a user of the scenario
+        // (CoupledSystem) sets.
+        if let Some(c) = s.vehicle.carrier() {
+            c.validate().map_err(|e| {
+                e.renamed(
+                    "vehicle.wheelbase",
+                    "wheelset[2].offset",
+                    "(the bogies' wheelbase)",
+                )
+                .renamed(
+                    "vehicle.bogie_distance",
+                    "wheelset[3].offset",
+                    "(the wagon's bogie centre distance)",
+                )
+            })?;
+        }
+        positive("wheel.radius", s.wheel_radius, "m")?;
+        finite("speed", s.speed, "m/s")?;
+        if s.speed < 0.0 {
+            return Err(out_of_range("speed", s.speed, ">= 0 m/s"));
+        }
+        finite("start_position", s.start_position, "m")?;
+        if s.start_position.abs() > MAX_START_POSITION {
+            return Err(out_of_range(
+                "start_position",
+                s.start_position,
+                format!(
+                    "-{MAX_START_POSITION:e} m <= start_position <= {MAX_START_POSITION:e} m \
+                 (positions along the line keep 1e-9 m of resolution there)"
+                ),
+            ));
+        }
+        non_negative("solver.dt", s.dt, "s")?;
+        non_negative("contact.Kw", s.kw, "N/m/rad")?;
+        non_negative("contact.CH", s.hertz_coefficient, "N/m^1.5")?;
+        if s.trailing.len() + 1 > MAX_WHEELSETS {
+            return Err(out_of_range(
+                "wheelsets",
+                (s.trailing.len() + 1) as f64,
+                format!("1 to {MAX_WHEELSETS} wheelsets"),
+            ));
+        }
+        for (k, w) in s.trailing.iter().enumerate() {
+            let name = format!("wheelset[{}].offset", k + 2);
+            positive(&name, w.offset, "m")?;
+            let before = if k == 0 {
+                0.0
+            } else {
+                s.trailing[k - 1].offset
+            };
+            // Wheels of the same rail cannot overlap: one wheel diameter apart at least.
+            let least = before + 2.0 * s.wheel_radius;
+            if w.offset.is_nan() || w.offset < least {
+                return Err(out_of_range(
+                    &name,
+                    w.offset,
+                    format!(
+                        ">= {} m, the wheelset ahead's offset {} m plus a wheel diameter \
+                     (wheelsets in order, the leading one first)",
+                        num(least),
+                        num(before)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
