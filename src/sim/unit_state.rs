@@ -1,6 +1,6 @@
 //! The vehicle unit's health checks (its held forces, its bodies) and its state
 //! vector: everything that determines its continuation, so that a saved run continues
-//! bit for bit (FMU states of RollPlaneVehicle and HalfCarBogie).
+//! bit for bit (FMU states of RollPlaneVehicle, HalfCarBogie and Wagon).
 
 use super::accelerations::Accelerations;
 use super::clock::ForceExtremes;

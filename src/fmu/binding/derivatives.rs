@@ -14,7 +14,7 @@ pub(super) fn no_derivative(r: u32) -> Error {
     Error::Unsupported(format!(
         "derivatives of `{}`: TrackContact interpolates wheel.*.z (orders 1 and 2) and \
          wheel.rotation (order 1) of each wheelset, with the contact interface; \
-         RollPlaneVehicle and HalfCarBogie give the first derivatives of wheel.*.z, \
+         RollPlaneVehicle, HalfCarBogie and Wagon give the first derivatives of wheel.*.z, \
          wheel.rotation and sideframe.*.z",
         name_of(r)
     ))
@@ -225,9 +225,9 @@ impl FmuModel {
         })
     }
 
-    /// RollPlaneVehicle and HalfCarBogie, first order: the wheel-centre and side-frame
-    /// velocities (backward differences over the last step) and the axle's rate
-    /// `speed / wheel.radius`.
+    /// RollPlaneVehicle, HalfCarBogie and Wagon, first order: the wheel-centre and
+    /// side-frame velocities (backward differences over the last step) and the axle's
+    /// rate `speed / wheel.radius`.
     pub(super) fn vehicle_output_derivative(&self, r: u32, order: i32) -> Result<f64, Error> {
         let Engine::Vehicle(u) = &self.engine else {
             return Err(no_derivative(r));

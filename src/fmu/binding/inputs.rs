@@ -155,7 +155,8 @@ impl FmuModel {
     pub(super) fn rest_input(&self, r: u32) -> Option<f64> {
         if let Engine::Vehicle(u) = &self.engine {
             // The held forces at rest: the axle-box interface's primary forces, the
-            // half-car's contact forces (which share its weight by its static state).
+            // contact forces of a vehicle on several wheelsets (which share its weight by
+            // its static state).
             let refs = match (u.is_axle_box(), u.wheelsets()) {
                 (true, _) => VEHICLE_AXLE_BOX_VRS,
                 (false, 1) => return None,

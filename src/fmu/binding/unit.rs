@@ -390,9 +390,9 @@ impl Model for FmuModel {
         }
     }
 
-    /// RollPlaneVehicle and HalfCarBogie, first order: the wheel-centre and side-frame
-    /// velocities (backward differences over the last step) and the axle's rate
-    /// `speed / wheel.radius`.
+    /// RollPlaneVehicle, HalfCarBogie and Wagon, first order: the wheel-centre and
+    /// side-frame velocities (backward differences over the last step) and the axle's
+    /// rate `speed / wheel.radius`.
     fn output_derivative(&self, r: u32, order: i32) -> Result<f64, Error> {
         self.vehicle_output_derivative(r, order)
     }

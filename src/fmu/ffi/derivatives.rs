@@ -58,8 +58,8 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     })
 }
 
-/// `fmi2GetRealOutputDerivatives`: the outputs' time derivatives (RollPlaneVehicle and
-/// HalfCarBogie: the wheel and side-frame velocities, the axle's rate;
+/// `fmi2GetRealOutputDerivatives`: the outputs' time derivatives (RollPlaneVehicle,
+/// HalfCarBogie and Wagon: the wheel and side-frame velocities, the axle's rate;
 /// `maxOutputDerivativeOrder="1"`).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
