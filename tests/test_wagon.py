@@ -126,7 +126,8 @@ def test_the_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent(paths):
 
 @pytest.mark.parametrize("offsets, message", [
     ({"wheelsets": 2}, "`wheelsets` = 2 is out of range: allowed 4 with the wagon"),
-    ({"wheelset[4].offset": 12.0}, "`wheelset[4].offset` = 12 is out of range: allowed 11.8 m"),
+    ({"wheelset[4].offset": 12.0}, "`wheelset[4].offset` = 12 is out of range: allowed 11.8 m, wheelset[3].offset + "
+                                   "wheelset[2].offset"),
     ({"wheelset[3].offset": 40.0, "wheelset[4].offset": 41.8}, "`wheelset[3].offset` = 40"),
 ])
 def test_coupled_system_refuses_a_wagon_on_other_wheelsets(paths, offsets, message, capfd):

@@ -334,12 +334,12 @@ fn carrier_on(s: &Scenario, dt: f64) -> Result<Option<Box<dyn RailVehicle>>> {
             format!("{} with {what}", offsets.len() + 1),
         ));
     }
-    for ((w, &x), k) in s.trailing.iter().zip(&offsets).zip(2..) {
+    for ((w, &(x, rule)), k) in s.trailing.iter().zip(&offsets).zip(2..) {
         if (w.offset - x).abs() > 1e-9 * x {
             return Err(out_of_range(
                 &format!("wheelset[{k}].offset"),
                 w.offset,
-                format!("{} m, its place in {what}", num(x)),
+                format!("{} m, {rule} in {what}", num(x)),
             ));
         }
     }

@@ -42,9 +42,10 @@ pub struct Bodies {
 pub trait CarrierModel {
     /// Number of wheelsets.
     fn wheelsets(&self) -> usize;
-    /// Where the wheelsets behind the leading one are (m behind it): the half-car's
-    /// wheelbase `a`; the wagon's `a`, `d`, `d + a` (`d` its bogie distance).
-    fn offsets(&self) -> Vec<f64>;
+    /// Where the wheelsets behind the leading one are (m behind it), each with what it
+    /// is in words: the half-car's wheelbase `a`; the wagon's `a`, `d`, `d + a` (`d`
+    /// its bogie distance).
+    fn offsets(&self) -> Vec<(f64, &'static str)>;
     /// The vehicle in words, with the value of `vehicle.model` that selects it.
     fn name(&self) -> &'static str;
     /// Checks every parameter, naming the variables.
@@ -71,8 +72,8 @@ impl CarrierModel for super::HalfCarParams {
     fn wheelsets(&self) -> usize {
         2
     }
-    fn offsets(&self) -> Vec<f64> {
-        vec![self.wheelbase]
+    fn offsets(&self) -> Vec<(f64, &'static str)> {
+        vec![(self.wheelbase, "the wheelbase")]
     }
     fn name(&self) -> &'static str {
         "the half-car bogie (vehicle.model = half_car)"

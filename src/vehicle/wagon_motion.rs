@@ -139,9 +139,17 @@ impl CarrierModel for WagonParams {
     fn wheelsets(&self) -> usize {
         4
     }
-    fn offsets(&self) -> Vec<f64> {
+    fn offsets(&self) -> Vec<(f64, &'static str)> {
         let (a, d) = (self.bogie.wheelbase, self.bogie_distance);
-        vec![a, d, d + a]
+        vec![
+            (a, "the wheelbase"),
+            (d, "the bogie centre distance"),
+            (
+                d + a,
+                "wheelset[3].offset + wheelset[2].offset, the rear bogie's trailing wheelset \
+                 a wheelbase behind its leading one",
+            ),
+        ]
     }
     fn name(&self) -> &'static str {
         "the wagon (vehicle.model = wagon)"
