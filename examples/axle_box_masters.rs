@@ -122,6 +122,7 @@ impl Case {
                 SideFrameSpec::HalfCar {
                     mass: h_params.sideframe_mass,
                     pitch_inertia,
+                    bogies: 1,
                 }
             } else {
                 SideFrameSpec::PerWheelset {

@@ -140,3 +140,50 @@ def test_coupled_system_refuses_a_wagon_on_other_wheelsets(paths, offsets, messa
         simulate_fmu(paths["CoupledSystem"], stop_time=0.01, start_values=dict(WAGON, **offsets))
     out = capfd.readouterr().out
     assert message in out, out
+
+
+@pytest.mark.parametrize("params, message", [
+    ({"vehicle.model": 3, "wheelsets": 2}, "`wheelsets` = 2 is out of range: allowed 4 with vehicle.model = wagon"),
+    ({"vehicle.model": 2, "wheelsets": 4, "wheelset[2].offset": 1.8, "wheelset[3].offset": 10.0,
+      "wheelset[4].offset": 11.8}, "`wheelsets` = 4 is out of range: allowed 2 with vehicle.model = half_car"),
+])
+def test_track_contact_at_the_axle_boxes_carries_the_side_frames_of_the_vehicle_it_names(paths, params, message, capfd):
+    # vehicle.model names the bogies whose side frames TrackContact carries: the wagon's
+    # two over four wheelsets, the half-car's one over two; another count is refused.
+    from fmpy import simulate_fmu
+    start = dict(ENDLESS, interface=2, **params)
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        simulate_fmu(paths["TrackContact"], stop_time=0.01, start_values=start)
+    out = capfd.readouterr().out
+    assert message in out, out
+
+
+def test_a_refused_wagon_geometry_names_the_offsets_coupled_system_has(paths, capfd):
+    # CoupledSystem has no vehicle.wheelbase or vehicle.bogie_distance: the wagon's
+    # refusal of a bogie distance below the wheelbase names the offsets that carry them.
+    from fmpy import simulate_fmu
+    start = dict(WAGON, **{"wheelset[2].offset": 5.0, "wheelset[3].offset": 4.5, "wheelset[4].offset": 9.5})
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        simulate_fmu(paths["CoupledSystem"], stop_time=0.01, start_values=start)
+    out = capfd.readouterr().out
+    assert "`wheelset[3].offset` = 4.5 is out of range: allowed wheelset[2].offset + 1 m = 6 m <=" in out, out
+    assert "vehicle." not in out.split("out of range")[1].split("\n")[0], out
+
+
+def test_the_wagon_at_rest_at_the_end_of_its_static_heights_range_steps(paths):
+    # The static wheel heights' range (0.05 m) is half the wheels' health bound: a wagon
+    # at rest at its end steps without tripping the bound; beyond it fmi2SetReal refuses.
+    u = wf.Unit(paths["Wagon"], "w")
+    u.fmu.setupExperiment(startTime=0.0)
+    u.set_parameters({"static_wheel_z.left": 0.05, "wheelset[4].static_wheel_z.right": -0.05})
+    u.fmu.enterInitializationMode()
+    u.fmu.exitInitializationMode()
+    for k in range(10):
+        u.fmu.doStep(k * 1e-3, 1e-3)
+    assert abs(u.get("wheel.left.z")[0] - 0.05) < 1e-6
+    u.close()
+    v = wf.Unit(paths["Wagon"], "v")
+    v.fmu.setupExperiment(startTime=0.0)
+    with pytest.raises(Exception, match="fmi2SetReal"):
+        v.set(["static_wheel_z.left"], [0.06])
+    v.close(terminate=False)

@@ -5,7 +5,7 @@
 //! own checks follow as each is built.
 
 use super::Scenario;
-use crate::error::{Result, finite, non_negative, num, out_of_range, positive};
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::MAX_WHEELSETS;
 
 /// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
@@ -18,8 +18,7 @@ impl Scenario {
     /// Errors: a value outside its range ([`crate::Error::Parameter`]): a vehicle on
     /// several wheelsets whose parameters its model refuses (its wheelbase named
     /// `wheelset[2].offset`, the wagon's bogie distance `wheelset[3].offset`), the wheel
-    /// radius, a negative or non-finite speed, a start beyond
-    /// 1e7 m, a negative step or contact constant, more than
+    /// radius, a negative or non-finite speed, a start beyond 1e7 m, a negative step or contact constant, more than
     /// [`MAX_WHEELSETS`] wheelsets, or wheelsets out of order or closer than a wheel
     /// diameter.
     pub fn validate(&self) -> Result<()> {
@@ -29,16 +28,32 @@ impl Scenario {
         // (CoupledSystem) sets.
         if let Some(c) = s.vehicle.carrier() {
             c.validate().map_err(|e| {
-                e.renamed(
-                    "vehicle.wheelbase",
-                    "wheelset[2].offset",
-                    "(the bogies' wheelbase)",
-                )
-                .renamed(
-                    "vehicle.bogie_distance",
-                    "wheelset[3].offset",
-                    "(the wagon's bogie centre distance)",
-                )
+                let e = e
+                    .renamed(
+                        "vehicle.wheelbase",
+                        "wheelset[2].offset",
+                        "(the bogies' wheelbase)",
+                    )
+                    .renamed(
+                        "vehicle.bogie_distance",
+                        "wheelset[3].offset",
+                        "(the wagon's bogie centre distance)",
+                    );
+                // The allowed range may name the other one too.
+                match e {
+                    Error::Parameter {
+                        name,
+                        value,
+                        allowed,
+                    } => Error::Parameter {
+                        name,
+                        value,
+                        allowed: allowed
+                            .replace("vehicle.wheelbase", "wheelset[2].offset")
+                            .replace("vehicle.bogie_distance", "wheelset[3].offset"),
+                    },
+                    other => other,
+                }
             })?;
         }
         positive("wheel.radius", s.wheel_radius, "m")?;

@@ -286,6 +286,9 @@ pub enum SideFrameSpec {
         mass: f64,
         /// Pitch inertia of one side frame about its centre (kg m^2).
         pitch_inertia: f64,
+        /// The bogies: 1, the half-car bogie's over wheelsets 1 and 2 (two wheelsets);
+        /// 2, the wagon's over 1 and 2 and over 3 and 4 (four wheelsets).
+        bogies: usize,
     },
 }
 
@@ -306,18 +309,24 @@ impl SideFrameSpec {
             SideFrameSpec::HalfCar {
                 mass,
                 pitch_inertia,
+                bogies,
             } => {
                 crate::limits::check("vehicle.sideframe.mass", 0.5 * mass)?;
                 crate::limits::check("vehicle.sideframe.pitch_inertia", pitch_inertia)?;
                 // Wheelsets 1 and 2 share side frames, and with four wheelsets (the
                 // wagon's two bogies) wheelsets 3 and 4 too, at the same wheelbase.
                 let n = s.trailing.len() + 1;
-                if n != 2 && n != 4 {
+                if n != 2 * bogies {
                     return Err(out_of_range(
                         "wheelsets",
                         n as f64,
-                        "2 with vehicle.model = half_car or 4 with vehicle.model = wagon at the \
-                         axle boxes (the bogies' side frames span wheelsets 1 and 2, and 3 and 4)",
+                        if bogies == 1 {
+                            "2 with vehicle.model = half_car at the axle boxes (the bogie's side \
+                             frames span wheelsets 1 and 2)"
+                        } else {
+                            "4 with vehicle.model = wagon at the axle boxes (the bogies' side \
+                             frames span wheelsets 1 and 2, and 3 and 4)"
+                        },
                     ));
                 }
                 let wheelbase = s.trailing[0].offset;

@@ -6,9 +6,17 @@ use super::simulation::{Simulation, TrackState};
 use super::vehicle_state::VehicleState;
 use super::wheelset::wheel_loads;
 use crate::contact::{ContactLaw, ContactModel, kw_from_hertz};
-use crate::error::{Result, non_negative, num, out_of_range};
+use crate::error::{Error, Result, non_negative, num, out_of_range};
 use crate::limits::{MAX_STATIC_OVERLAP, MAX_STATIC_RAIL_DEFLECTION, within};
 use crate::sim::{Scenario, TrackSpec, VehicleSpec};
+
+/// Passes of the static start's track and vehicle on several wheelsets
+/// ([`Simulation::set_static`]); each settles the loads by about the ratio of the
+/// suspension's twist stiffness to the track's (a tenth with table 4.4).
+pub(crate) const STATIC_ITERATIONS: usize = 50;
+/// How close the loads that hold a vehicle on several wheelsets must come to those the
+/// track carries, as a fraction of the static wheel load.
+pub(crate) const STATIC_LOAD_TOLERANCE: f64 = 1e-10;
 use crate::wheel::WheelProfile;
 
 /// The static load on each wheel `[left, right]` (N) of the scenario's vehicle: the
@@ -88,23 +96,71 @@ impl Simulation {
     /// Static equilibrium of the whole system at the start position: static wheel
     /// loads from the vehicle, track deflection under the loads of every wheelset
     /// (direct solve), overlaps from the inverse contact law, then the vehicle resting
-    /// on those wheel heights.
+    /// on those wheel heights. A vehicle on several wheelsets is not determinate in
+    /// twist (the wagon, the half-car bogie): the loads that hold it on uneven wheel
+    /// heights (a flat or a rail defect under a wheel) differ from the equal static
+    /// loads, so the track and the vehicle are solved again with the vehicle's loads
+    /// until they agree to [`STATIC_LOAD_TOLERANCE`] of the static load.
+    ///
+    /// Errors: the track's static solve; a suspension that does not hold the bodies;
+    /// no agreement within [`STATIC_ITERATIONS`] passes.
     pub(crate) fn set_static(&mut self) -> Result<()> {
+        let n = self.wheelsets.len();
+        let mut loads = vec![self.static_load; n];
+        for _ in 0..STATIC_ITERATIONS {
+            self.rest_on(&loads)?;
+            let Some(b) = &mut self.carrier else {
+                return Ok(());
+            };
+            let z: crate::vehicle::Axles = std::array::from_fn(|k| {
+                self.wheelsets
+                    .get(k)
+                    .and_then(|w| w.vehicle.wheel_z())
+                    .unwrap_or([0.0; 2])
+            });
+            let held = b.set_static(&z)?;
+            self.sync_carrier_wheels();
+            let scale = self.static_load[0].max(self.static_load[1]).max(1.0);
+            let change = (0..n)
+                .flat_map(|k| (0..2).map(move |i| (k, i)))
+                .map(|(k, i)| (held[k][i] - loads[k][i]).abs())
+                .fold(0.0, f64::max);
+            if change <= STATIC_LOAD_TOLERANCE * scale {
+                return Ok(());
+            }
+            for (l, h) in loads.iter_mut().zip(held) {
+                *l = h;
+            }
+        }
+        Err(Error::Unsupported(format!(
+            "static equilibrium of the vehicle on the track: the wheel loads did not settle \
+             within {STATIC_ITERATIONS} passes (a suspension too stiff in twist for the \
+             track under it)"
+        )))
+    }
+
+    /// The track under the wheel loads `loads[k]` `[left, right]` (N) of every wheelset
+    /// at rest, and each wheelset's wheels (its vehicle) at rest on it.
+    fn rest_on(&mut self, loads: &[[f64; 2]]) -> Result<()> {
         self.clear_cache();
         let x = self.position() - self.origin;
         let p = self.static_load;
         match &mut self.track {
             TrackState::Discrete(t) => {
                 wheel_loads(x, &self.wheelsets, |_| p, &mut self.loads);
+                for (pair, l) in self.loads.chunks_exact_mut(2).zip(loads) {
+                    pair[0].force = l[0];
+                    pair[1].force = l[1];
+                }
                 t.set_static(&self.loads)?;
             }
             TrackState::Lumped(t) => t.set_static(p),
         }
-        for k in 0..self.wheelsets.len() {
+        for (k, &p) in loads.iter().enumerate() {
             let w = self.wheelsets.get(k).expect("k < len");
             let xw = w.position(x);
             // The rail under each wheel: the nodes' deflection there, lowered by the
-            // static load through the rail's local compliance between nodes.
+            // wheel's load through the rail's local compliance between nodes.
             let zr = match &self.track {
                 TrackState::Discrete(t) => {
                     let c = t.shear_compliance(xw);
@@ -116,8 +172,8 @@ impl Simulation {
             // The rails' profiles and the wheels' out-of-roundness where they touch.
             let h = self.irregularity(k);
             let zw = [zr[0] - delta[0] + h[0], zr[1] - delta[1] + h[1]];
-            // The static loads start the first step's contact solve (the force of
-            // "the step before"), so a wheelset at rest stays there to rounding.
+            // The loads start the first step's contact solve (the force of "the step
+            // before"), so a wheelset at rest stays there to rounding.
             let latest = &mut self.wheelsets.get_mut(k).expect("k < len").latest;
             for (c, &f) in latest.contact.iter_mut().zip(&p) {
                 c.force = f;
@@ -131,16 +187,6 @@ impl Simulation {
                     *wheel_z = zw
                 }
             }
-        }
-        if let Some(b) = &mut self.carrier {
-            let z: crate::vehicle::Axles = std::array::from_fn(|k| {
-                self.wheelsets
-                    .get(k)
-                    .and_then(|w| w.vehicle.wheel_z())
-                    .unwrap_or([0.0; 2])
-            });
-            b.set_static(&z)?;
-            self.sync_carrier_wheels();
         }
         Ok(())
     }

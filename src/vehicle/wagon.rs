@@ -39,6 +39,10 @@ pub const fn bogie_start(b: usize) -> usize {
     3 + 8 * b
 }
 
+/// Least distance (m) between the front bogie's trailing wheelset and the rear bogie's
+/// leading one.
+pub const MIN_BOGIE_GAP: f64 = 1.0;
+
 /// Parameters of the wagon.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WagonParams {
@@ -89,8 +93,8 @@ impl WagonParams {
 
     /// Checks every parameter: the bogie's as the half-car's; the car body's mass (a
     /// quarter of it, `vehicle.carbody_mass`), its inertias and the bogie distance in
-    /// their ranges ([`crate::limits::check`]); the bogie distance more than the
-    /// wheelbase.
+    /// their ranges ([`crate::limits::check`]); the bogie distance at least the
+    /// wheelbase plus [`MIN_BOGIE_GAP`].
     pub fn validate(&self) -> Result<()> {
         self.bogie.validate()?;
         crate::limits::check("vehicle.carbody_mass", 0.25 * self.carbody_mass)?;
@@ -98,13 +102,18 @@ impl WagonParams {
         crate::limits::check("vehicle.carbody.roll_inertia", self.carbody_roll_inertia)?;
         crate::limits::check("vehicle.bogie_distance", self.bogie_distance)?;
         let d = self.bogie_distance;
-        if d <= self.bogie.wheelbase {
+        // The front bogie's trailing wheelset and the rear bogie's leading one at least
+        // a metre apart (more than a wheel's diameter, which the track needs between
+        // wheelsets).
+        let least = self.bogie.wheelbase + MIN_BOGIE_GAP;
+        if d < least {
             return Err(out_of_range(
                 "vehicle.bogie_distance",
                 d,
                 format!(
-                    "vehicle.wheelbase = {} m < vehicle.bogie_distance <= 30 m",
-                    self.bogie.wheelbase
+                    "vehicle.wheelbase + {MIN_BOGIE_GAP} m = {} m <= vehicle.bogie_distance <= \
+                     30 m (the bogies' inner wheelsets at least {MIN_BOGIE_GAP} m apart)",
+                    crate::error::num(least)
                 ),
             ));
         }

@@ -232,6 +232,11 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
                 SideFrameSpec::HalfCar {
                     mass: 2.0 * val(vr::VEHICLE_SIDEFRAME_MASS),
                     pitch_inertia: val(vr::VEHICLE_SIDEFRAME_PITCH_INERTIA),
+                    bogies: if val(vr::VEHICLE_MODEL) == enums::vehicle_model::WAGON {
+                        2
+                    } else {
+                        1
+                    },
                 }
             } else {
                 SideFrameSpec::PerWheelset {
