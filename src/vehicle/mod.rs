@@ -47,5 +47,5 @@ pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels
 pub use rail_vehicle::{Axles, Bodies, CarrierModel, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
-pub use wagon::{WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
+pub use wagon::{MIN_BOGIE_GAP, WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
 pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};
