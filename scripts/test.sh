@@ -30,7 +30,7 @@ python3 python/wheelflat_fmus.py
 # test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem;
 # test_docs.py: the commands of README.md and docs/guide/ run (or matched to the test
 # that runs them) and the documentation's links
-.venv/bin/python -m pytest -q tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py
+.venv/bin/python -m pytest -q tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
 
 echo "   (${SECONDS} s so far)"
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
