@@ -9,6 +9,7 @@ use crate::contact::{ContactLaw, ContactModel, kw_from_hertz};
 use crate::error::{Error, Result, non_negative, num, out_of_range};
 use crate::limits::{MAX_STATIC_OVERLAP, MAX_STATIC_RAIL_DEFLECTION, within};
 use crate::sim::{Scenario, TrackSpec, VehicleSpec};
+use crate::wheel::WheelProfile;
 
 /// Passes of the static start's track and vehicle on several wheelsets
 /// ([`Simulation::set_static`]); each settles the loads by about the ratio of the
@@ -17,7 +18,6 @@ pub(crate) const STATIC_ITERATIONS: usize = 50;
 /// How close the loads that hold a vehicle on several wheelsets must come to those the
 /// track carries, as a fraction of the static wheel load.
 pub(crate) const STATIC_LOAD_TOLERANCE: f64 = 1e-10;
-use crate::wheel::WheelProfile;
 
 /// The static load on each wheel `[left, right]` (N) of the scenario's vehicle: the
 /// roll-plane vehicle's weight share (table 4.4: 107.6 kN), the lumped wheel's load, the
