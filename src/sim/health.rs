@@ -106,7 +106,26 @@ impl Simulation {
     /// extremes) beyond the health bounds, as the error that names it: wheel and rail
     /// under the wheel within [`DISPLACEMENT_LIMIT`], contact forces and their extremes
     /// within the force limit.
+    #[inline]
     fn sample_beyond_bounds(&self, w: &Wheelset, k: usize, s: &Sample) -> Option<Error> {
+        let (lim, d) = (self.force_limit, DISPLACEMENT_LIMIT);
+        let (max, min) = (w.max_force(), w.min_force());
+        // Every value within its bound (the run's every step): no list to build.
+        let within_all = s.wheel_z.iter().chain(&s.rail_z).all(|&x| within(x, d))
+            && s.contact.iter().all(|c| within(c.force, lim))
+            && max.iter().all(|&x| within(x.max(0.0), lim))
+            && min.iter().all(|&x| within(x.min(0.0), lim));
+        if within_all {
+            return None;
+        }
+        self.sample_error(w, k, s)
+    }
+
+    /// [`Simulation::sample_beyond_bounds`]'s error: the first value beyond its bound,
+    /// named.
+    #[cold]
+    #[inline(never)]
+    fn sample_error(&self, w: &Wheelset, k: usize, s: &Sample) -> Option<Error> {
         let lim = self.force_limit;
         let (max, min) = (w.max_force(), w.min_force());
         let values = [
