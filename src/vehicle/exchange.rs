@@ -132,13 +132,10 @@ impl TrackSide {
             });
             link.step(p);
         }
-        // Each bogie's two wheelsets share their side frames.
-        if self.links.len() >= 2 {
-            for pair in self.links.chunks_exact_mut(2) {
-                let (a, b) = (pair[0].last_force(), pair[1].last_force());
-                pair[0].set_partner_force(b);
-                pair[1].set_partner_force(a);
-            }
+        if self.links.len() == 2 {
+            let (a, b) = (self.links[0].last_force(), self.links[1].last_force());
+            self.links[0].set_partner_force(b);
+            self.links[1].set_partner_force(a);
         }
     }
 }
@@ -166,7 +163,7 @@ fn amplification<B: SprungBody>(
     let track = &track;
     let s0 = body.state();
     let nv = s0.len() - 1;
-    let moving = if track.links.len() >= 2 {
+    let moving = if track.links.len() == 2 {
         &LINK_MOVING[..]
     } else {
         &LINK_MOVING[..8]
