@@ -4,9 +4,9 @@
 //! track that carries the wheelsets ([`super::PrimaryLink`]). Both advance by the
 //! central differences of the roll-plane vehicle with the damping as in (3.25).
 
+use super::rail_vehicle::{axles, bodies_beyond, wheels_beyond};
 use super::{HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarParams, HalfCarVector};
 use crate::error::{Error, Result, positive};
-use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
 use crate::numerics::CentralDifference;
 use nalgebra::{SMatrix, SVector};
 
@@ -77,17 +77,6 @@ fn primary_forces(p: &HalfCarParams, d: &HalfCarVector, v: &HalfCarVector) -> Qu
                 + p.primary_damping * (vf[i][s] - vb[i][s]))
         })
     })
-}
-
-/// The first value beyond the health bounds: a body at `t_j` or `t_(j-1)` beyond
-/// [`BODY_DISPLACEMENT_LIMIT`].
-fn bodies_beyond<const N: usize>(cd: &CentralDifference<N>) -> Option<(&'static str, f64, f64)> {
-    cd.d()
-        .iter()
-        .chain(cd.d_prev().iter())
-        .enumerate()
-        .map(|(i, &x)| (HALF_CAR_DOF_NAMES[i % N], x, BODY_DISPLACEMENT_LIMIT))
-        .find(|&(_, x, l)| !within(x, l))
 }
 
 /// The half-car bogie in time: ten degrees of freedom ([`HALF_CAR_DOF_NAMES`]) under
@@ -202,21 +191,10 @@ impl HalfCarBogie {
     }
 
     /// The first value beyond the health bounds: a body beyond
-    /// [`BODY_DISPLACEMENT_LIMIT`], a wheel beyond [`DISPLACEMENT_LIMIT`].
+    /// [`crate::limits::BODY_DISPLACEMENT_LIMIT`], a wheel beyond [`crate::limits::DISPLACEMENT_LIMIT`].
     pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        const WHEELS: [&str; 4] = [
-            "wheel.left.z (m)",
-            "wheel.right.z (m)",
-            "wheelset[2].wheel.left.z (m)",
-            "wheelset[2].wheel.right.z (m)",
-        ];
-        bodies_beyond(&self.cd).or_else(|| {
-            WHEELS
-                .into_iter()
-                .zip(self.wheel_z().into_iter().flatten())
-                .map(|(n, x)| (n, x, DISPLACEMENT_LIMIT))
-                .find(|&(_, x, l)| !within(x, l))
-        })
+        bodies_beyond(&self.cd, |i| HALF_CAR_DOF_NAMES[i])
+            .or_else(|| wheels_beyond(&axles(self.wheel_z()), 2))
     }
 }
 
@@ -331,8 +309,8 @@ impl SprungHalfCar {
             .restore(v, "bogie state length", |h| p.check_time_step(h))
     }
 
-    /// A body beyond [`BODY_DISPLACEMENT_LIMIT`].
+    /// A body beyond [`crate::limits::BODY_DISPLACEMENT_LIMIT`].
     pub fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        bodies_beyond(&self.cd)
+        bodies_beyond(&self.cd, |i| HALF_CAR_DOF_NAMES[i])
     }
 }

@@ -14,6 +14,8 @@
 
 use super::{ExchangeLimits, HalfCarBogie, SprungHalfCar};
 use crate::error::Result;
+use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
+use crate::numerics::CentralDifference;
 
 /// Most wheelsets one vehicle rests on (the wagon's four).
 pub const MAX_AXLES: usize = 4;
@@ -195,13 +197,48 @@ impl Clone for Box<dyn SprungVehicle> {
     }
 }
 
+/// The first value of `cd` at `t_j` or `t_(j-1)` beyond [`BODY_DISPLACEMENT_LIMIT`],
+/// named by `names` (a degree of freedom's index to its name): the bodies' health
+/// check of every vehicle on several wheelsets.
+pub(super) fn bodies_beyond<const N: usize>(
+    cd: &CentralDifference<N>,
+    names: impl Fn(usize) -> &'static str,
+) -> Option<(&'static str, f64, f64)> {
+    cd.d()
+        .iter()
+        .chain(cd.d_prev().iter())
+        .enumerate()
+        .map(|(i, &x)| (names(i % N), x, BODY_DISPLACEMENT_LIMIT))
+        .find(|&(_, x, l)| !within(x, l))
+}
+
+/// The first wheel centre of the first `wheelsets` of `z` (m) beyond
+/// [`DISPLACEMENT_LIMIT`], named as the FMUs name it.
+pub(super) fn wheels_beyond(z: &Axles, wheelsets: usize) -> Option<(&'static str, f64, f64)> {
+    const WHEELS: [&str; 2 * MAX_AXLES] = [
+        "wheel.left.z (m)",
+        "wheel.right.z (m)",
+        "wheelset[2].wheel.left.z (m)",
+        "wheelset[2].wheel.right.z (m)",
+        "wheelset[3].wheel.left.z (m)",
+        "wheelset[3].wheel.right.z (m)",
+        "wheelset[4].wheel.left.z (m)",
+        "wheelset[4].wheel.right.z (m)",
+    ];
+    WHEELS
+        .into_iter()
+        .zip(z.iter().take(wheelsets).flatten())
+        .map(|(n, &x)| (n, x, DISPLACEMENT_LIMIT))
+        .find(|&(_, x, l)| !within(x, l))
+}
+
 /// The first two wheelsets of `a`.
 fn pair(a: &Axles) -> super::Quad {
     [a[0], a[1]]
 }
 
 /// `q` as the first two wheelsets.
-fn axles(q: super::Quad) -> Axles {
+pub(super) fn axles(q: super::Quad) -> Axles {
     [q[0], q[1], [0.0; 2], [0.0; 2]]
 }
 

@@ -5,10 +5,11 @@
 //! roll-plane vehicle with the damping as in (3.25), as the half-car bogie does, and
 //! both stand behind [`RailVehicle`] and [`SprungVehicle`].
 
-use super::rail_vehicle::{Axles, Bodies, CarrierModel, RailVehicle, SprungVehicle};
+use super::rail_vehicle::{
+    Axles, Bodies, CarrierModel, RailVehicle, SprungVehicle, bodies_beyond, wheels_beyond,
+};
 use super::{ExchangeLimits, WAGON_DOFS, WagonParams, WagonVector, bogie_start};
 use crate::error::{Error, Result, positive};
-use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
 use crate::numerics::{CentralDifference, check_critical_step};
 use nalgebra::{SMatrix, SVector};
 
@@ -190,20 +191,6 @@ fn not_held() -> Error {
     )
 }
 
-/// The first value of `cd` at `t_j` or `t_(j-1)` beyond [`BODY_DISPLACEMENT_LIMIT`],
-/// named by `names`.
-fn bodies_beyond<const N: usize>(
-    cd: &CentralDifference<N>,
-    names: impl Fn(usize) -> &'static str,
-) -> Option<(&'static str, f64, f64)> {
-    cd.d()
-        .iter()
-        .chain(cd.d_prev().iter())
-        .enumerate()
-        .map(|(i, &x)| (names(i % N), x, BODY_DISPLACEMENT_LIMIT))
-        .find(|&(_, x, l)| !within(x, l))
-}
-
 /// The wagon in time: nineteen degrees of freedom under gravity and the eight contact
 /// forces, by the central differences of the roll-plane vehicle with the damping as in
 /// (3.25) (the half-car bogie's scheme).
@@ -322,23 +309,8 @@ impl RailVehicle for Wagon {
             .restore(v, "wagon state length", |h| p.check_time_step(h))
     }
     fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        const WHEELS: [&str; 8] = [
-            "wheel.left.z (m)",
-            "wheel.right.z (m)",
-            "wheelset[2].wheel.left.z (m)",
-            "wheelset[2].wheel.right.z (m)",
-            "wheelset[3].wheel.left.z (m)",
-            "wheelset[3].wheel.right.z (m)",
-            "wheelset[4].wheel.left.z (m)",
-            "wheelset[4].wheel.right.z (m)",
-        ];
-        bodies_beyond(&self.cd, |i| WAGON_DOF_NAMES[i]).or_else(|| {
-            WHEELS
-                .into_iter()
-                .zip(RailVehicle::wheel_z(self).into_iter().flatten())
-                .map(|(n, x)| (n, x, DISPLACEMENT_LIMIT))
-                .find(|&(_, x, l)| !within(x, l))
-        })
+        bodies_beyond(&self.cd, |i| WAGON_DOF_NAMES[i])
+            .or_else(|| wheels_beyond(&RailVehicle::wheel_z(self), 4))
     }
     fn clone_box(&self) -> Box<dyn RailVehicle> {
         Box::new(self.clone())
