@@ -360,7 +360,7 @@ impl VehicleUnit {
     pub fn bodies(&self) -> Option<Bodies> {
         match &self.body {
             Body::Carrier(b) => Some(b.bodies()),
-            Body::SprungCarrier(b) => b.bodies(&self.params.static_wheels()),
+            Body::SprungCarrier(b) => Some(b.bodies()),
             _ => None,
         }
     }

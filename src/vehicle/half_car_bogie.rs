@@ -215,6 +215,9 @@ pub struct SprungHalfCar {
     params: HalfCarParams,
     cd: CentralDifference<SPRUNG_DOFS>,
     gravity: SVector<f64, SPRUNG_DOFS>,
+    /// The whole bogie's static state of [`SprungHalfCar::set_static`] (zero before):
+    /// the wheelsets' part, which the partner carries, for the outputs.
+    rest: HalfCarVector,
 }
 
 impl SprungHalfCar {
@@ -237,6 +240,7 @@ impl SprungHalfCar {
             params,
             cd: CentralDifference::new(&m, k, c, dt),
             gravity: params.gravity_force().fixed_rows::<6>(0).into_owned(),
+            rest: HalfCarVector::zeros(),
         })
     }
 
@@ -249,6 +253,15 @@ impl SprungHalfCar {
     pub fn dt(&self) -> f64 {
         self.cd.dt()
     }
+    /// The whole bogie's displacements (m, rad), in the order of
+    /// [`HALF_CAR_DOF_NAMES`]: these bodies' now, the wheelsets' at rest
+    /// ([`SprungHalfCar::set_static`]).
+    pub fn whole_displacements(&self) -> HalfCarVector {
+        let mut d = self.rest;
+        d.fixed_rows_mut::<6>(0).copy_from(self.cd.d());
+        d
+    }
+
     /// `{z_b, phi_b, z_sfl, theta_sfl, z_sfr, theta_sfr}` at `t_j` (m, rad).
     pub fn displacements(&self) -> &SVector<f64, SPRUNG_DOFS> {
         self.cd.d()
@@ -287,6 +300,7 @@ impl SprungHalfCar {
         let d = self.params.static_state(z_wheel).ok_or_else(not_held)?;
         let top = d.fixed_rows::<6>(0).into_owned();
         self.cd.set_state(top, top);
+        self.rest = d;
         // At rest: the springs alone.
         Ok(primary_forces(&self.params, &d, &HalfCarVector::zeros()))
     }

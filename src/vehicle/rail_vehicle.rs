@@ -162,9 +162,9 @@ pub trait SprungVehicle: std::fmt::Debug + Send + Sync {
     /// The side frames' displacements and velocities above every wheelset's axle boxes
     /// (m, m/s).
     fn side_frames(&self) -> (Axles, Axles);
-    /// The bodies' motion, the wheelsets at rest on `z` (m); `None` when the suspension
-    /// does not hold them there.
-    fn bodies(&self, z: &Axles) -> Option<Bodies>;
+    /// The bodies' motion, the wheelsets at rest where
+    /// [`SprungVehicle::set_static`] put them.
+    fn bodies(&self) -> Bodies;
     /// Advances one step under the primary forces `f` (N, pressing the axle boxes down)
     /// held over it.
     fn step(&mut self, f: &Axles);
@@ -327,10 +327,8 @@ impl SprungVehicle for SprungHalfCar {
         let (z, v) = SprungHalfCar::side_frames(self);
         (axles(z), axles(v))
     }
-    fn bodies(&self, z: &Axles) -> Option<Bodies> {
-        let mut d = self.params().static_state(pair(z))?;
-        d.fixed_rows_mut::<6>(0).copy_from(self.displacements());
-        Some(half_car_bodies(&d))
+    fn bodies(&self) -> Bodies {
+        half_car_bodies(&self.whole_displacements())
     }
     fn step(&mut self, f: &Axles) {
         SprungHalfCar::step(self, pair(f))

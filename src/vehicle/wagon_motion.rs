@@ -327,6 +327,9 @@ pub struct SprungWagon {
     params: WagonParams,
     cd: CentralDifference<SPRUNG_DOFS>,
     gravity: SVector<f64, SPRUNG_DOFS>,
+    /// The whole wagon's static state of `set_static` (zero before): the wheelsets'
+    /// part, which the partner carries, for the outputs.
+    rest: WagonVector,
 }
 
 impl SprungWagon {
@@ -355,6 +358,7 @@ impl SprungWagon {
                 dt,
             ),
             gravity: SVector::from_fn(|i, _| g[SPRUNG[i]]),
+            rest: WagonVector::zeros(),
         })
     }
 
@@ -382,12 +386,12 @@ impl SprungVehicle for SprungWagon {
             self.params.frames_at_boxes(v.as_slice()),
         )
     }
-    fn bodies(&self, z: &Axles) -> Option<Bodies> {
-        let mut d = self.params.static_state(octet(z))?;
+    fn bodies(&self) -> Bodies {
+        let mut d = self.rest;
         for (i, &k) in SPRUNG.iter().enumerate() {
             d[k] = self.cd.d()[i];
         }
-        Some(self.params.bodies(d.as_slice()))
+        self.params.bodies(d.as_slice())
     }
     fn step(&mut self, f: &Axles) {
         let mut g = self.gravity;
@@ -405,6 +409,7 @@ impl SprungVehicle for SprungWagon {
         let d = self.params.static_state(octet(z)).ok_or_else(not_held)?;
         let top = SVector::from_fn(|i, _| d[SPRUNG[i]]);
         self.cd.set_state(top, top);
+        self.rest = d;
         // At rest: the springs alone.
         Ok(self
             .params
