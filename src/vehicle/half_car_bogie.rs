@@ -133,15 +133,21 @@ impl HalfCarBogie {
         wheels_of(&self.params, self.cd.d())
     }
 
-    /// The side frames' displacements and velocities `[left, right]` (m, m/s) above
-    /// wheelset `k`'s axle boxes (0 leading, 1 trailing; the pitch included), the
+    /// Wheel-centre velocities `[[left, right] of wheelset 1, of wheelset 2]` (m/s),
+    /// backward differences over the last step.
+    pub fn wheel_velocities(&self) -> Quad {
+        wheels_of(&self.params, &self.cd.velocities())
+    }
+
+    /// The side frames' displacements and velocities at the four axle boxes (m, m/s),
+    /// `[[left, right] over wheelset 1, over wheelset 2]` (the pitch included), the
     /// velocities backward differences over the last step.
-    pub fn side_frames_of(&self, k: usize) -> ([f64; 2], [f64; 2]) {
+    pub fn side_frames(&self) -> (Quad, Quad) {
         let v = self.cd.velocities();
         let p = &self.params;
         (
-            p.frames_at_boxes(self.cd.d().as_slice())[k.min(1)],
-            p.frames_at_boxes(v.as_slice())[k.min(1)],
+            p.frames_at_boxes(self.cd.d().as_slice()),
+            p.frames_at_boxes(v.as_slice()),
         )
     }
 

@@ -269,19 +269,14 @@ impl RailVehicle for HalfCarBogie {
         axles(HalfCarBogie::wheel_z(self))
     }
     fn wheel_velocities(&self) -> Axles {
-        let v = self.velocities();
-        let h = 0.5 * self.params().primary_spacing;
-        axles([0, 1].map(|k| {
-            let (z, phi) = (v[6 + 2 * k], v[7 + 2 * k]);
-            [z - h * phi, z + h * phi]
-        }))
+        axles(HalfCarBogie::wheel_velocities(self))
     }
     fn bearing_forces(&self) -> Axles {
         axles(HalfCarBogie::bearing_forces(self))
     }
     fn side_frames(&self) -> (Axles, Axles) {
-        let [(z0, v0), (z1, v1)] = [0, 1].map(|k| self.side_frames_of(k));
-        (axles([z0, z1]), axles([v0, v1]))
+        let (z, v) = HalfCarBogie::side_frames(self);
+        (axles(z), axles(v))
     }
     fn displacements(&self) -> &[f64] {
         HalfCarBogie::displacements(self).as_slice()
