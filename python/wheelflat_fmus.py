@@ -139,17 +139,8 @@ def track_step(paths, track_params=None):
 def static_handshake(track, vehicle, track_params=None, vehicle_params=None):
     """Parameters and the static-equilibrium handshake, leaving both in initialization
     mode: the vehicle's static wheel loads to the track, the track's static wheel
-    heights back."""
-    for u in (track, vehicle):
-        u.fmu.setupExperiment(startTime=0.0)
-    track.set_parameters(track_params)
-    vehicle.set_parameters(vehicle_params)
-    vehicle.fmu.enterInitializationMode()
-    track.fmu.enterInitializationMode()
-    loads = ("static_load.left", "static_load.right")
-    track.set(loads, vehicle.get(*loads))
-    heights = ("static_wheel_z.left", "static_wheel_z.right")
-    vehicle.set(heights, track.get(*heights))
+    heights back (:func:`carrier_handshake` of one wheelset)."""
+    carrier_handshake(track, vehicle, 1, track_params, vehicle_params)
 
 
 def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
@@ -312,23 +303,24 @@ HEIGHTS = ("static_wheel_z.left", "static_wheel_z.right")
 
 def carrier_handshake(track, vehicle, n, track_params, vehicle_params):
     """Parameters and the static handshake of TrackContact carrying the `n` wheelsets of
-    a vehicle on several wheelsets (HalfCarBogie: 2, Wagon: 4): its static loads to the
+    a vehicle (RollPlaneVehicle: 1, HalfCarBogie: 2, Wagon: 4): its static loads to the
     track, every wheelset's static wheel heights back; both left in initialization
-    mode. TrackContact's offsets are the vehicle's: ``wheelset[2].offset`` its
-    ``vehicle.wheelbase``, and for the Wagon ``wheelset[3].offset`` its
-    ``vehicle.bogie_distance`` and ``wheelset[4].offset`` their sum."""
+    mode. With several wheelsets TrackContact's offsets are the vehicle's:
+    ``wheelset[2].offset`` its ``vehicle.wheelbase``, and for the Wagon
+    ``wheelset[3].offset`` its ``vehicle.bogie_distance`` and ``wheelset[4].offset``
+    their sum."""
     vp = dict(vehicle_params or {})
-    tp = dict(track_params or {}, wheelsets=n)
+    tp = dict(track_params or {})
     for u in (track, vehicle):
         u.fmu.setupExperiment(startTime=0.0)
     vehicle.set_parameters(vp)
-    start = {v.name: v.start for v in vehicle.md.modelVariables}
-    a = float(vp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
-    tp["wheelset[2].offset"] = a
-    if n == 4:
-        d = float(vp.get("vehicle.bogie_distance", start["vehicle.bogie_distance"]))
-        tp["wheelset[3].offset"] = d
-        tp["wheelset[4].offset"] = d + a
+    if n > 1:
+        start = {v.name: v.start for v in vehicle.md.modelVariables}
+        a = float(vp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
+        tp.update({"wheelsets": n, "wheelset[2].offset": a})
+        if n == 4:
+            d = float(vp.get("vehicle.bogie_distance", start["vehicle.bogie_distance"]))
+            tp.update({"wheelset[3].offset": d, "wheelset[4].offset": d + a})
     track.set_parameters(tp)
     vehicle.fmu.enterInitializationMode()
     track.fmu.enterInitializationMode()
@@ -338,11 +330,6 @@ def carrier_handshake(track, vehicle, n, track_params, vehicle_params):
     for k in range(2, n + 1):
         names = trailing(k, HEIGHTS)
         vehicle.set(names, track.get(*names))
-
-
-def half_car_handshake(track, bogie, track_params, bogie_params):
-    """:func:`carrier_handshake` of the HalfCarBogie (two wheelsets)."""
-    carrier_handshake(track, bogie, 2, track_params, bogie_params)
 
 
 def every_wheelset(n, names):
