@@ -94,7 +94,7 @@ fn peaks(f: &[Quad]) -> Quad {
 impl Case {
     fn new(half_car: bool, k1: f64, c1: f64, duration: f64) -> Case {
         let mut mono = Scenario::table_4_4_flat();
-        mono.window = Some(TrackWindow::DEFAULT);
+        mono.window = Some(TrackWindow::CONVERGED);
         let mut p = roll_plane(&mono);
         p.primary_stiffness = k1;
         p.primary_damping = c1;

@@ -53,7 +53,7 @@ fn main() {
         .nth(1)
         .map_or(1.0, |a| a.parse().expect("DECELERATION (m/s^2)"));
     let mut s = Scenario::table_4_4_flat();
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = Some(TrackWindow::CONVERGED);
     let v0 = kmh(100.0);
     s.speed = v0;
     let mut sim = Simulation::new(&s).unwrap();

@@ -33,7 +33,7 @@ fn main() {
         if linear {
             s.set_between_nodes(RailBetweenNodes::Linear);
         }
-        s.window = Some(TrackWindow::DEFAULT);
+        s.window = Some(TrackWindow::CONVERGED);
         s.start_position = 10.0 * 0.685;
         let mut sim = Simulation::new(&s).unwrap();
         let dt = sim.dt();

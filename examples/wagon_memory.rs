@@ -20,7 +20,7 @@ fn peak_rss_kib() -> u64 {
 
 fn main() {
     let mut s = Scenario::table_4_4_flat();
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = Some(TrackWindow::CONVERGED);
     s.trailing = [1.8, 10.0, 11.8]
         .iter()
         .map(|&offset| TrailingWheelset {

@@ -5,7 +5,15 @@
 //! fixed track started in its middle (the impacts at the same places relative to the
 //! sleepers). Prints, per window: the largest force of each wheelset against the
 //! reference's, the largest difference of the whole force history over the static
-//! load, and the wall time. `cargo run --release --example window_study [AHEAD:BEHIND]...`
+//! load, and the wall time. A window `AHEAD:BEHIND:LAYER:RATE` adds absorbing layers of
+//! LAYER m with the largest damping rate RATE (1/s) beyond both sides (issue 29); the
+//! window `0:0` is the thesis' fixed 30-span track instead.
+//!
+//! With `DEFAULT_START=1` the runs start where the FMUs start (1.37 m, two spans from
+//! the fixed track's end) and last `DURATION` s (then 0.95 s: the wheel's whole run on
+//! the fixed 30-span track), one wheelset only, and `0:0` is among the default windows:
+//! the FMUs' old default (the fixed track) against their new one (10 m a side).
+//! `cargo run --release --example window_study [AHEAD:BEHIND[:LAYER:RATE]]...`
 use std::time::Instant;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
 
@@ -28,29 +36,43 @@ fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
 }
 
 fn main() {
+    let default_start = std::env::var("DEFAULT_START").is_ok();
     let duration: f64 = std::env::var("DURATION")
         .ok()
-        .map_or(1.0, |v| v.parse().expect("DURATION"));
-    let mut windows: Vec<(f64, f64)> = std::env::args()
+        .map_or(if default_start { 0.95 } else { 1.0 }, |v| {
+            v.parse().expect("DURATION")
+        });
+    let mut windows: Vec<(f64, f64, f64, f64)> = std::env::args()
         .skip(1)
         .map(|a| {
-            let (x, y) = a.split_once(':').expect("AHEAD:BEHIND");
-            (x.parse().unwrap(), y.parse().unwrap())
+            let v: Vec<f64> = a.split(':').map(|x| x.parse().expect("a number")).collect();
+            match v[..] {
+                [x, y] => (x, y, 0.0, 0.0),
+                [x, y, l, r] => (x, y, l, r),
+                _ => panic!("AHEAD:BEHIND or AHEAD:BEHIND:LAYER:RATE"),
+            }
         })
         .collect();
     if windows.is_empty() {
-        windows = vec![
-            (4.0, 4.0),
-            (8.0, 8.0),
-            (12.0, 12.0),
-            (16.0, 16.0),
-            (20.0, 20.0),
-            (30.0, 30.0),
-        ];
+        windows = if default_start {
+            [0.0, 6.0, 8.0, 10.0, 12.0, 20.0].to_vec()
+        } else {
+            [4.0, 8.0, 12.0, 16.0, 20.0, 30.0].to_vec()
+        }
+        .into_iter()
+        .map(|x| (x, x, 0.0, 0.0))
+        .collect();
     }
-    for bogie in [false, true] {
+    let cases: &[bool] = if default_start {
+        &[false]
+    } else {
+        &[false, true]
+    };
+    for &bogie in cases {
         let mut base = Scenario::table_4_4_flat();
-        base.start_position = 10.0 * 0.685;
+        if !default_start {
+            base.start_position = 10.0 * 0.685;
+        }
         if bogie {
             base.trailing.push(TrailingWheelset {
                 offset: 1.8,
@@ -83,12 +105,17 @@ fn main() {
             wall
         );
         println!(
-            "| ahead (m) | behind (m) | spans | peak error per wheelset (%) | largest history difference / static load (%) | wall (s) |"
+            "| ahead (m) | behind (m) | layer (m) | rate (1/s) | spans | peak error per wheelset (%) | largest history difference / static load (%) | wall (s) |"
         );
-        println!("|---|---|---|---|---|---|");
-        for &(ahead, behind) in &windows {
+        println!("|---|---|---|---|---|---|---|---|");
+        for &(ahead, behind, layer, layer_rate) in &windows {
             let mut s = base.clone();
-            s.window = Some(TrackWindow { ahead, behind });
+            s.window = (ahead > 0.0).then_some(TrackWindow {
+                ahead,
+                behind,
+                layer,
+                layer_rate,
+            });
             let spans = Simulation::new(&s).unwrap().rail_nodes() / 2 / 8;
             let (h, wall) = history(&s, duration);
             let p = peaks(&h);
@@ -102,8 +129,16 @@ fn main() {
                 .zip(&reference)
                 .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
                 .fold(0.0, f64::max);
+            if std::env::var("WHEN").is_ok() {
+                let dt = duration / h.len() as f64;
+                for (j, (a, b)) in h.iter().zip(&reference).enumerate() {
+                    if (a[0] - b[0]).abs() > 0.5 * diff {
+                        eprintln!("t = {:.4} s: {:.0} N", j as f64 * dt, a[0] - b[0]);
+                    }
+                }
+            }
             println!(
-                "| {ahead} | {behind} | {spans} | {} | {:.3} | {wall:.2} |",
+                "| {ahead} | {behind} | {layer} | {layer_rate} | {spans} | {} | {:.3} | {wall:.2} |",
                 errs.join(", "),
                 100.0 * diff / load
             );

@@ -359,7 +359,7 @@ fn quiet_lines(n: usize, between: RailBetweenNodes) -> (f64, f64) {
     let mut s = Scenario::table_4_4();
     s.set_nodes_per_span(n);
     s.set_between_nodes(between);
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = Some(TrackWindow::CONVERGED);
     s.start_position = 10.0 * 0.685;
     let mut sim = Simulation::new(&s).unwrap();
     let dt = sim.dt();

@@ -22,7 +22,7 @@ fn half_car_scenario() -> Scenario {
         offset: 1.8,
         ..Default::default()
     }];
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = Some(TrackWindow::CONVERGED);
     s
 }
 

@@ -173,7 +173,7 @@ fn the_endless_track_reads_the_rail_profile_where_its_window_is() {
     fixed.set_spans(120);
     fixed.rails[0].defect = Some(weld);
     let mut endless = fixed.clone();
-    endless.window = Some(TrackWindow::DEFAULT);
+    endless.window = Some(TrackWindow::CONVERGED);
     let (ff, load) = forces(&fixed, 0.35);
     let (fe, _) = forces(&endless, 0.35);
     let worst = ff

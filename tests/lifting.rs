@@ -78,7 +78,7 @@ fn a_wheelset_closes_the_gap_under_hanging_sleepers_on_the_endless_track() {
     // gap under the one it stands over closes: the sleeper sits on the ballast.
     let run = |voids: Option<VoidedSleepers>| {
         let mut s = Scenario::table_4_4();
-        s.window = Some(TrackWindow::DEFAULT);
+        s.window = Some(TrackWindow::CONVERGED);
         s.speed = 70.0 / 3.6;
         s.start_position = 10.0;
         s.voids = voids;
@@ -137,6 +137,7 @@ fn a_site_the_endless_window_leaves_behind_keeps_its_accelerations() {
         s.window = Some(TrackWindow {
             ahead: 20.0,
             behind,
+            ..TrackWindow::DEFAULT
         });
         s.speed = 70.0 / 3.6;
         s.sites = vec![10.275];
@@ -179,6 +180,7 @@ fn hanging_sleepers_under_tensionless_supports_start_at_rest_on_any_window() {
         s.window = Some(TrackWindow {
             ahead,
             behind: 20.0,
+            ..TrackWindow::DEFAULT
         });
         Simulation::new(&s).unwrap().sites()[0].now()[0][0]
     };

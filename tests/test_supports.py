@@ -95,10 +95,11 @@ def test_hanging_sleepers_on_the_endless_track_close_their_gap_under_the_wheel(c
     ({"track.void.gap": 0.1},
      "`track.void.gap` = 0.1 m is out of range; allowed: finite, 0 <= track.void.gap <= 0.01 m"),
     # Hanging sleepers beyond the fixed track's 31 sleepers, refused at initialisation.
-    ({"track.void.sleepers": 3, "track.void.position": 50.0},
+    ({"track.window.ahead": 0.0, "track.void.sleepers": 3, "track.void.position": 50.0},
      "parameter `track.void.position` = 50 is out of range: allowed a run of track.void.sleepers = 3 "
      "sleepers within the fixed track's 31 sleepers: -0.3425 m <= track.void.position < 19.5225 m"),
-    ({"track.void.sleepers": 40, "track.void.position": 1.0}, "track.void.sleepers = 40"),
+    ({"track.window.ahead": 0.0, "track.void.sleepers": 40, "track.void.position": 1.0},
+     "track.void.sleepers = 40"),
 ])
 def test_hanging_sleepers_out_of_range_are_refused_by_name(coupled, capfd, start, message):
     with pytest.raises(FMICallException):

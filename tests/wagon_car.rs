@@ -29,7 +29,7 @@ fn wagon_scenario() -> Scenario {
             ..Default::default()
         })
         .to_vec();
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = Some(TrackWindow::CONVERGED);
     s
 }
 

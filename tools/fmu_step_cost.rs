@@ -36,7 +36,12 @@ fn main() {
         println!("engine step: {:.3} us", w * 1e6);
     }
     if which == "fmu" || which == "both" {
-        let (c, _) = ffi_instance::initialised(TRACK_CONTACT.guid, &[], &[]);
+        let (c, _) = ffi_instance::initialised(
+            TRACK_CONTACT.guid,
+            // The thesis' fixed track, as the engine's (the FMUs' default is the endless).
+            &[(vr::TRACK_WINDOW_AHEAD, 0.0)],
+            &[],
+        );
         let inputs = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
         let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
         unsafe {

@@ -81,7 +81,7 @@ fn main() {
                 offset: 1.8,
                 ..Default::default()
             }];
-            s.window = Some(TrackWindow::DEFAULT);
+            s.window = Some(TrackWindow::CONVERGED);
         }
         "wagon" => {
             let VehicleSpec::RollPlane(p) = s.vehicle else {
@@ -94,7 +94,7 @@ fn main() {
                     ..Default::default()
                 })
                 .to_vec();
-            s.window = Some(TrackWindow::DEFAULT);
+            s.window = Some(TrackWindow::CONVERGED);
         }
         other => panic!("unknown option {other}"),
     }

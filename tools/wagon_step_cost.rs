@@ -2,8 +2,11 @@
 //! wheelsets of a four-axle wagon (0, 1.8, 10, 11.8 m), through the C boundary
 //! (fmi2DoStep of solver.step, the contact forces read) against the engine's own step
 //! of the same scenario, for instruction counting:
-//! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS`
-//! (subtract a run of 0 steps). Without valgrind it prints wall time per step.
+//! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS [SIDE]`
+//! (subtract a run of 0 steps). SIDE (m) is the window's length ahead and behind
+//! (default: the converged 20 m); 0 runs the fixed 30-span track instead. A fifth
+//! argument K makes each fmi2DoStep K steps long (default 1). Without valgrind it
+//! prints wall time per step.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -21,8 +24,15 @@ fn main() {
     let which = arg(1).unwrap_or_else(|| "both".into());
     let wheelsets: usize = arg(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let n: u64 = arg(3).and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    let side: f64 = arg(4)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(TrackWindow::CONVERGED.ahead);
     let mut s = Scenario::table_4_4_flat();
-    s.window = Some(TrackWindow::DEFAULT);
+    s.window = (side > 0.0).then_some(TrackWindow {
+        ahead: side,
+        behind: side,
+        ..TrackWindow::DEFAULT
+    });
     s.trailing = WAGON[..wheelsets - 1]
         .iter()
         .map(|&offset| TrailingWheelset {
@@ -40,10 +50,15 @@ fn main() {
         println!("engine step, {wheelsets} wheelsets: {:.3} us", w * 1e6);
     }
     if which == "fmu" || which == "both" {
-        let mut reals = vec![(vr::TRACK_WINDOW_AHEAD, TrackWindow::DEFAULT.ahead)];
+        let mut reals = vec![(vr::TRACK_WINDOW_AHEAD, side)];
+        if side > 0.0 {
+            reals.push((vr::TRACK_WINDOW_BEHIND, side));
+        }
         reals.extend(OFFSET_VRS.iter().copied().zip(WAGON));
         let integers = [(vr::WHEELSETS, wheelsets as i32)];
+        let per_call: u64 = arg(5).and_then(|s| s.parse().ok()).unwrap_or(1);
         let (c, dt) = ffi_instance::initialised(COUPLED_SYSTEM.guid, &reals, &integers);
+        let (n, dt) = (n / per_call, dt * per_call as f64);
         let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];
         unsafe {
             let mut p = [0.0; 2];
@@ -53,7 +68,7 @@ fn main() {
                 fmi2GetReal(c, outputs.as_ptr(), 2, p.as_mut_ptr());
                 black_box(p);
             }
-            let w = t0.elapsed().as_secs_f64() / n as f64;
+            let w = t0.elapsed().as_secs_f64() / (n * per_call) as f64;
             println!(
                 "CoupledSystem step, {wheelsets} wheelsets: {:.3} us",
                 w * 1e6

@@ -11,7 +11,7 @@ use super::static_start::{contact_law, static_loads};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::ContactLaw;
-use crate::error::{Error, Result, finite, num, out_of_range, positive};
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::{MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
@@ -116,14 +116,25 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
             ));
         }
     }
-    let spans = ((spec.ahead + spec.behind + d_max) / a).ceil() as usize + 1;
+    finite("track.window.layer", spec.layer, "m")?;
+    if !(0.0..=MAX_WINDOW_SIDE).contains(&spec.layer) {
+        return Err(out_of_range(
+            "track.window.layer",
+            spec.layer,
+            format!("0 m <= track.window.layer <= {MAX_WINDOW_SIDE} m"),
+        ));
+    }
+    non_negative("track.window.layer_rate", spec.layer_rate, "1/s")?;
+    // The absorbing layers lie beyond `ahead` and `behind`.
+    let l = spec.layer;
+    let spans = ((spec.ahead + spec.behind + 2.0 * l + d_max) / a).ceil() as usize + 1;
     p.spans = spans;
     let len = spans as f64 * a;
-    let j = ((x0 - (len - spec.ahead)) / a).ceil();
+    let j = ((x0 - (len - spec.ahead - l)) / a).ceil();
     Ok(Window {
         spec,
         origin_span: j as i64,
-        shift_at: len - spec.ahead,
+        shift_at: len - spec.ahead - l,
         spacing: a,
     })
 }
@@ -227,7 +238,13 @@ impl Simulation {
                         ));
                     }
                 }
-                TrackState::Discrete(Track::new(*p, dt)?)
+                let mut t = Track::new(*p, dt)?;
+                if let Some(w) = &window
+                    && w.spec.layer > 0.0
+                {
+                    t.set_absorbing_ends(w.spec.layer, w.spec.layer_rate)?;
+                }
+                TrackState::Discrete(t)
             }
             TrackSpec::Lumped(p) => {
                 if wheelsets.len() > 1 {

@@ -16,6 +16,7 @@
 //! down on the sleeper; pad damper velocities are backward differences so the rail
 //! update stays explicit; ballast damping uses central differences (3.18).
 
+mod absorbing;
 mod irregularity;
 mod kernels;
 mod observe;

@@ -90,6 +90,8 @@ pub struct Track {
     /// Supports that can lift ([`SupportLaw::Tensionless`] or a gap under a sleeper);
     /// `None`: the thesis' linear supports.
     pub(super) unilateral: Option<Box<Unilateral>>,
+    /// A graded damping layer at the rail ends ([`Track::set_absorbing_ends`]).
+    pub(super) absorbing: Option<Box<absorbing::AbsorbingEnds>>,
 }
 
 impl Track {
@@ -185,6 +187,7 @@ impl Track {
             simd: SimdLevel::detect(),
             unilateral: (params.supports.law == SupportLaw::Tensionless)
                 .then(|| Box::new(Unilateral::new(&params, ns, dt))),
+            absorbing: None,
         }
     }
 
@@ -361,6 +364,9 @@ impl Track {
     /// Advances the track from t_j to t_(j+1) under point loads applied at t_j.
     #[inline(always)]
     pub fn step(&mut self, loads: &[PointLoad]) {
+        if self.absorbing.is_some() {
+            self.absorbing_save();
+        }
         match self.simd {
             // No hardware FMA assumed at the baseline (the library `fma` is slow).
             SimdLevel::Baseline => step_body::<false>(self, loads),
@@ -368,6 +374,9 @@ impl Track {
                 #[inline(always)]
                 || step_body::<true>(self, loads),
             ),
+        }
+        if self.absorbing.is_some() {
+            self.absorbing_apply();
         }
     }
 }
@@ -413,7 +422,9 @@ impl Track {
             }
         }
         self.c = Coeffs::new(&self.params, dt);
+        let dt_old = self.dt;
         self.dt = dt;
+        self.absorbing_rescale(dt_old, dt);
         if let Some(u) = &mut self.unilateral {
             u.set_dt(&self.params, dt);
         }

@@ -1,8 +1,8 @@
 //! Where TrackContact's displacement inputs are measured from (`inputs.datum`).
 //!
-//! The static wheel heights (and side-frame displacements) depend on the track: -1.3811
-//! mm on the default fixed track, -1.5336 mm on the endless one, -1.5973 / -1.6428 mm
-//! under a half-car bogie there. A partner model started at rest on other heights (its
+//! The static wheel heights (and side-frame displacements) depend on the track: -1.5336
+//! mm on the default endless track, -1.3811 mm on the thesis' fixed one (two spans from
+//! its end), -1.5973 / -1.6428 mm under a half-car bogie on the endless track. A partner model started at rest on other heights (its
 //! start values, its own static state) would hit the rail at its first step. With
 //! `inputs.datum = first_step` (the default) the heights the track receives at its first
 //! communication step are its static state: each input is moved by the fixed offset

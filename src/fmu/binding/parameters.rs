@@ -269,6 +269,7 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         window: (val(vr::TRACK_WINDOW_AHEAD) > 0.0).then(|| TrackWindow {
             ahead: val(vr::TRACK_WINDOW_AHEAD),
             behind: val(vr::TRACK_WINDOW_BEHIND),
+            ..TrackWindow::DEFAULT
         }),
         voids: (val(vr::TRACK_VOID_SLEEPERS) > 0.0).then(|| VoidedSleepers {
             position: val(vr::TRACK_VOID_POSITION),

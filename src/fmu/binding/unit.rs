@@ -253,8 +253,8 @@ impl Model for FmuModel {
         Some(format!(
             "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track at \
              t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
-             stopTime, and an endless track (track.window.ahead = 20, the converged window) \
-             any stopTime",
+             stopTime, and the endless track (track.window.ahead > 0, the default; 20 m is \
+             the converged window) any stopTime",
             start + t_end
         ))
     }

@@ -132,7 +132,7 @@ fn wheel_inputs_far_into_the_rail_stop_the_run_with_an_error() {
 
 #[test]
 fn an_unreachable_stop_time_is_named_at_initialisation() {
-    let (mut i, log) = instance(Kind::CoupledSystem);
+    let (mut i, log) = fixed_track_instance(Kind::CoupledSystem);
     i.setup_experiment(0.0, Some(2.0)).unwrap();
     i.enter_initialization().unwrap();
     // Initialised, with the warning as the status.
@@ -368,7 +368,7 @@ fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
 
 #[test]
 fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_per_run() {
-    let (mut i, log) = instance(Kind::CoupledSystem);
+    let (mut i, log) = fixed_track_instance(Kind::CoupledSystem);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     let warnings = |log: &Arc<Mutex<Vec<String>>>| {
@@ -378,7 +378,7 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
             .filter(|m| m.contains("fixed rail end") && !m.contains("still"))
             .count()
     };
-    // Default track: 30 spans of 0.685 m, 20.55 m; the zone starts two spans before
+    // The fixed track: 30 spans of 0.685 m, 20.55 m; the zone starts two spans before
     // the end, at 19.18 m, which the wheel reaches from 1.37 m at 70 km/h at 0.916 s.
     let h = 1e-3;
     let mut t = 0.0;

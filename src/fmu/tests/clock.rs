@@ -94,7 +94,7 @@ fn a_master_clock_with_rounding_runs_whole_steps_at_the_seed_grid() {
     // The thesis' model at its grid: the rail between nodes interpolated by (3.23).
     let mut i = coupled(
         0.0,
-        &[(vr::SOLVER_DT, dt)],
+        &[(vr::SOLVER_DT, dt), (vr::TRACK_WINDOW_AHEAD, 0.0)],
         &[
             (vr::TRACK_NODES_PER_SPAN, 2),
             (vr::TRACK_RAIL_BETWEEN_NODES, 2),

@@ -4,9 +4,12 @@ use super::*;
 
 #[test]
 fn default_start_values_are_the_reference_scenario() {
+    // Table 4.4 with the reference flat, on the endless track's default window.
     let (i, _) = instance(Kind::CoupledSystem);
+    let mut reference = Scenario::table_4_4_flat();
+    reference.window = Some(crate::sim::TrackWindow::DEFAULT);
     let mut a = Simulation::new(&i.scenario()).unwrap();
-    let mut b = Simulation::new(&Scenario::table_4_4_flat()).unwrap();
+    let mut b = Simulation::new(&reference).unwrap();
     for _ in 0..3000 {
         assert_eq!(a.step().unwrap(), b.step().unwrap());
     }
@@ -134,7 +137,7 @@ fn terminate_and_status_follow_the_state_table() {
 
 #[test]
 fn after_the_model_ended_the_run_steps_are_refused_and_outputs_readable() {
-    let (mut i, log) = instance(Kind::CoupledSystem);
+    let (mut i, log) = fixed_track_instance(Kind::CoupledSystem);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     i.do_step(0.0, 0.01).unwrap();

@@ -20,6 +20,14 @@ pub(super) fn instance(kind: Kind) -> (Instance, Arc<Mutex<Vec<String>>>) {
     (Instance::new(kind.table(), "test", logger, false), log)
 }
 
+/// A new instance of `kind` on the thesis' fixed 30-span track (`track.window.ahead =
+/// 0`; the default is the endless track).
+pub(super) fn fixed_track_instance(kind: Kind) -> (Instance, Arc<Mutex<Vec<String>>>) {
+    let (mut i, log) = instance(kind);
+    i.set_real(&[vr::TRACK_WINDOW_AHEAD], &[0.0]).unwrap();
+    (i, log)
+}
+
 /// A calculated parameter or output of `i`.
 pub(super) fn real(i: &mut Instance, r: u32) -> f64 {
     let mut x = [0.0];
