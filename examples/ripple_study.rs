@@ -1,5 +1,5 @@
 //! The quiet force's spectrum (issue 27): table 4.4's vehicle and track, perfect wheels,
-//! 70 km/h, the endless track (the default window), the left wheel's contact force over
+//! 70 km/h, the endless track (the converged window, 20 m a side), the left wheel's contact force over
 //! whole sleeper-passing periods after 0.2 s, for several grids (nodes per span n).
 //! At steady state the force is periodic with the sleeper passing period `a / V`, so
 //! its spectrum is the harmonics `k V / a`; the n-th harmonic is the node-passing line

@@ -1,11 +1,13 @@
 //! A four-axle wagon (wheelsets 0, 1.8, 10 and 11.8 m behind the leading one, the
 //! reference flat on the leading wheelset's left wheel) on the endless track at the
-//! converged grid and the default window, 60 s at 70 km/h: the peak resident memory
+//! converged grid and the converged window (20 m a side), 60 s at 70 km/h: the peak resident memory
 //! (VmHWM) and the wall time at 1, 10 and 60 s of simulated time. Memory stays constant
 //! because the window moves with the wagon. Linux only (reads /proc/self/status).
 //! The wagon is the whole car body on two half-car bogies (`vehicle.model = wagon`);
-//! with the argument `roll_plane`, a roll-plane vehicle on each wheelset.
-//! `cargo run --release --example wagon_memory [roll_plane]`
+//! with the argument `roll_plane`, a roll-plane vehicle on each wheelset; with `one`,
+//! the reference flat case alone (one wheelset) on the FMUs' default window (10 m a
+//! side, issue 29).
+//! `cargo run --release --example wagon_memory [roll_plane|one]`
 use std::time::Instant;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec};
 use wheelflat::vehicle::WagonParams;
@@ -19,6 +21,7 @@ fn peak_rss_kib() -> u64 {
 }
 
 fn main() {
+    let which = std::env::args().nth(1).unwrap_or_default();
     let mut s = Scenario::table_4_4_flat();
     s.window = Some(TrackWindow::CONVERGED);
     s.trailing = [1.8, 10.0, 11.8]
@@ -28,7 +31,10 @@ fn main() {
             ..Default::default()
         })
         .collect();
-    if std::env::args().nth(1).as_deref() != Some("roll_plane") {
+    if which == "one" {
+        s.window = Some(TrackWindow::DEFAULT);
+        s.trailing.clear();
+    } else if which != "roll_plane" {
         let VehicleSpec::RollPlane(p) = s.vehicle else {
             unreachable!("the preset has the roll-plane vehicle")
         };
@@ -37,7 +43,8 @@ fn main() {
     let before = peak_rss_kib();
     let mut sim = Simulation::new(&s).unwrap();
     println!(
-        "four wheelsets, window of {} spans; peak RSS before building: {before} KiB",
+        "{} wheelsets, window of {} spans; peak RSS before building: {before} KiB",
+        sim.wheelsets().len(),
         sim.rail_nodes() / 2 / 8
     );
     println!(
@@ -51,11 +58,11 @@ fn main() {
         done = mark;
         let w = sim.wheelsets();
         println!(
-            "| {mark} | {:.1} | {} | {:.2} | {} |",
+            "| {mark} | {:.1} | {} | {:.3} | {} |",
             sim.position(),
             peak_rss_kib(),
             t0.elapsed().as_secs_f64(),
-            (0..4)
+            (0..w.len())
                 .map(|k| format!("{:.1}", w.get(k).unwrap().max_force()[0] / 1e3))
                 .collect::<Vec<_>>()
                 .join(" / ")

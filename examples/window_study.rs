@@ -13,6 +13,11 @@
 //! the fixed track's end) and last `DURATION` s (then 0.95 s: the wheel's whole run on
 //! the fixed 30-span track), one wheelset only, and `0:0` is among the default windows:
 //! the FMUs' old default (the fixed track) against their new one (10 m a side).
+//! `SPEED` (m/s) sets the speed (default 70 km/h).
+//!
+//! With `SPECTRUM=1` each row also names the frequency of the largest line of the
+//! leading wheelset's history difference between 100 Hz and 5 kHz (a Hann-windowed DFT
+//! in 2 Hz steps).
 //! `cargo run --release --example window_study [AHEAD:BEHIND[:LAYER:RATE]]...`
 use std::time::Instant;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
@@ -24,7 +29,10 @@ fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
     let mut h = Vec::with_capacity(n);
     let t0 = Instant::now();
     for _ in 0..n {
-        sim.step().unwrap();
+        // The fixed track ends the run where the wheel leaves it (`0:0` at speed).
+        if sim.step().is_err() {
+            break;
+        }
         h.push(
             sim.wheelsets()
                 .iter()
@@ -33,6 +41,32 @@ fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
         );
     }
     (h, t0.elapsed().as_secs_f64())
+}
+
+/// Frequency (Hz) of the largest line of `e` (sampled every `dt` s) between 100 Hz and
+/// 5 kHz: a Hann-windowed DFT in 2 Hz steps.
+fn strongest_line(e: &[f64], dt: f64) -> f64 {
+    use std::f64::consts::PI;
+    let m = e.len() as f64;
+    let w: Vec<f64> = e
+        .iter()
+        .enumerate()
+        .map(|(i, x)| x * 0.5 * (1.0 - (2.0 * PI * i as f64 / m).cos()))
+        .collect();
+    let power = |f: f64| {
+        let (mut re, mut im) = (0.0, 0.0);
+        for (i, x) in w.iter().enumerate() {
+            let (s, c) = (2.0 * PI * f * i as f64 * dt).sin_cos();
+            re += x * c;
+            im -= x * s;
+        }
+        re * re + im * im
+    };
+    (50..2500)
+        .map(|k| 2.0 * k as f64)
+        .map(|f| (f, power(f)))
+        .fold((0.0, f64::MIN), |a, b| if b.1 > a.1 { b } else { a })
+        .0
 }
 
 fn main() {
@@ -70,6 +104,9 @@ fn main() {
     };
     for &bogie in cases {
         let mut base = Scenario::table_4_4_flat();
+        if let Ok(v) = std::env::var("SPEED") {
+            base.speed = v.parse().expect("SPEED in m/s");
+        }
         if !default_start {
             base.start_position = 10.0 * 0.685;
         }
@@ -119,6 +156,8 @@ fn main() {
             let spans = Simulation::new(&s).unwrap().rail_nodes() / 2 / 8;
             let (h, wall) = history(&s, duration);
             let p = peaks(&h);
+            // Over the run's own length (a fixed track may end it early).
+            let p_ref = peaks(&reference[..h.len()]);
             let errs: Vec<String> = p
                 .iter()
                 .zip(&p_ref)
@@ -137,8 +176,22 @@ fn main() {
                     }
                 }
             }
+            let line = if std::env::var("SPECTRUM").is_ok() {
+                let e: Vec<f64> = h.iter().zip(&reference).map(|(a, b)| a[0] - b[0]).collect();
+                format!(" {:.0} Hz |", strongest_line(&e, duration / h.len() as f64))
+            } else {
+                String::new()
+            };
+            let until = if h.len() < reference.len() {
+                format!(
+                    " (to {:.3} s)",
+                    duration * h.len() as f64 / reference.len() as f64
+                )
+            } else {
+                String::new()
+            };
             println!(
-                "| {ahead} | {behind} | {layer} | {layer_rate} | {spans} | {} | {:.3} | {wall:.2} |",
+                "| {ahead} | {behind} | {layer} | {layer_rate} | {spans}{until} | {} | {:.3} | {wall:.2} |{line}",
                 errs.join(", "),
                 100.0 * diff / load
             );

@@ -6,7 +6,8 @@ docs/PERFORMANCE.md:
 - CoupledSystem through fmpy's FMU2Slave at 0.05 s communication steps, set-up not
   timed, best of three, per simulated second (issue 29's measurement): the thesis'
   fixed 30-span track (0.95 s, the wheel's whole run on it), the default window, the
-  converged 20 m window, four wheelsets of the wagon and the half-car bogie;
+  converged 20 m window, four wheelsets (roll-plane vehicles, and the wagon) and the
+  half-car bogie;
 - the fmpy FMU2Slave pair loop of python/couple.py, per communication step.
 
     python3 python/fmu_speed.py
@@ -24,8 +25,11 @@ CASES = [
     ("the thesis' fixed 30-span track", {"track.window.ahead": 0.0}, 0.95),
     ("the default endless track, 10 m a side", {}, 1.0),
     ("the converged window, 20 m a side", CONVERGED, 1.0),
-    ("four wheelsets of the wagon, default window", {"wheelsets": 4, **WAGON}, 1.0),
-    ("four wheelsets of the wagon, converged window", {"wheelsets": 4, **WAGON, **CONVERGED}, 1.0),
+    ("four roll-plane vehicles on the wagon's wheelsets, default window", {"wheelsets": 4, **WAGON}, 1.0),
+    ("four roll-plane vehicles on the wagon's wheelsets, converged window",
+     {"wheelsets": 4, **WAGON, **CONVERGED}, 1.0),
+    ("the wagon, default window", {"wheelsets": 4, **WAGON, "vehicle.model": 3}, 1.0),
+    ("the wagon, converged window", {"wheelsets": 4, **WAGON, "vehicle.model": 3, **CONVERGED}, 1.0),
     ("the half-car bogie, default window", {"wheelsets": 2, "wheelset[2].offset": 1.8,
                                             "vehicle.model": 2}, 1.0),
 ]

@@ -69,7 +69,7 @@ def test_tensionless_supports_let_go_where_the_thesis_pads_pull(coupled):
 def test_hanging_sleepers_on_the_endless_track_close_their_gap_under_the_wheel(coupled):
     # Three sleepers hang 0.3 mm above the ballast from 20.55 m on; the wheelset
     # rolls over them at 70 km/h on the endless track.
-    start = {"track.window.ahead": 20.0, "speed": 70 / 3.6, "start_position": 10.0,
+    start = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "speed": 70 / 3.6, "start_position": 10.0,
              "track.void.sleepers": 3, "track.void.position": 20.6, "track.void.gap": 3e-4,
              "sites": 1, "site[1].position": 31 * A}
     out = ["site[1].ballast.left.lifted", "site[1].ballast.left.lifted.max",
@@ -117,7 +117,7 @@ def test_a_saved_state_of_lifting_supports_continues_bit_for_bit(coupled):
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(coupled),
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName="state")
     fmu.instantiate()
-    start = {"track.window.ahead": 20.0, "track.supports": 2, "track.pad.preload": 5e3,
+    start = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "track.supports": 2, "track.pad.preload": 5e3,
              "track.void.sleepers": 4, "track.void.position": 14.0, "track.void.gap": 2e-4,
              "sites": 1, "site[1].position": 14.4}
     fmu.setupExperiment(startTime=0.0)

@@ -339,6 +339,35 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
         ..TrackWindow::DEFAULT
     });
     assert_eq!(name(&s), "track.window.behind");
+    // A window too long for the rail's segments is named by the window (breaker, issue
+    // 29: it was blamed on track.spans, which the endless track sets itself); 64 nodes
+    // a span allow 1,561 spans, 1,069.285 m.
+    s.window = Some(TrackWindow {
+        ahead: 1000.0,
+        behind: 1000.0,
+        ..TrackWindow::DEFAULT
+    });
+    s.set_nodes_per_span(64);
+    match Simulation::new(&s) {
+        Err(wheelflat::Error::Parameter { name, allowed, .. }) => {
+            assert_eq!(name, "track.window.ahead");
+            assert!(
+                allowed.contains("track.window.behind <= 1069.285 m"),
+                "{allowed}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    s.set_nodes_per_span(8);
+    // A moving window needs the fixed rail ends: refused when built, not mid-run.
+    s.window = Some(TrackWindow::DEFAULT);
+    if let wheelflat::sim::TrackSpec::Discrete(p) = &mut s.track {
+        p.ends = wheelflat::track::RailEnds::Pinned;
+    }
+    assert!(matches!(
+        Simulation::new(&s),
+        Err(wheelflat::Error::Unsupported(_))
+    ));
     let mut sim = Simulation::new(&Scenario::table_4_4()).unwrap();
     for v in [-1.0, f64::NAN, 1e3] {
         match sim.set_speed(v) {

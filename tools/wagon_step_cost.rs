@@ -1,4 +1,4 @@
-//! Cost of one step of CoupledSystem on the endless track's default window with 1 to 4
+//! Cost of one step of CoupledSystem on the endless track's converged window (or SIDE) with 1 to 4
 //! wheelsets of a four-axle wagon (0, 1.8, 10, 11.8 m), through the C boundary
 //! (fmi2DoStep of solver.step, the contact forces read) against the engine's own step
 //! of the same scenario, for instruction counting:

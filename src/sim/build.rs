@@ -12,9 +12,9 @@ use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::{MIN_DT_FRACTION, force_limit};
+use crate::limits::{MAX_RAIL_SEGMENTS, MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
-use crate::track::{PointLoad, RailProfile, SimdLevel, Track, TrackParams};
+use crate::track::{PointLoad, RailEnds, RailProfile, SimdLevel, Track, TrackParams};
 use crate::vehicle::{LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
@@ -125,9 +125,36 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
         ));
     }
     non_negative("track.window.layer_rate", spec.layer_rate, "1/s")?;
+    if p.ends != RailEnds::Fixed {
+        return Err(Error::Unsupported(
+            "a moving window on a track with pinned ends (track.window.ahead > 0 needs the \
+             fixed rail ends)"
+                .into(),
+        ));
+    }
     // The absorbing layers lie beyond `ahead` and `behind`.
     let l = spec.layer;
     let spans = ((spec.ahead + spec.behind + 2.0 * l + d_max) / a).ceil() as usize + 1;
+    // The window's own length, named by its own parameters (the fixed track's
+    // track.spans, which it replaces, is not the user's to change here).
+    let n = p.nodes_per_span.max(1);
+    if spans.saturating_mul(n) > MAX_RAIL_SEGMENTS {
+        let most = (MAX_RAIL_SEGMENTS / n - 1) as f64 * a - d_max - 2.0 * l;
+        return Err(out_of_range(
+            "track.window.ahead",
+            spec.ahead,
+            format!(
+                "track.window.ahead + track.window.behind <= {} m with track.nodes_per_span \
+                 = {n}, track.sleeper_spacing = {} m and the wheelsets {} m apart: the \
+                 window's {spans} spans x {n} nodes exceed {MAX_RAIL_SEGMENTS} rail segments \
+                 (track.window.behind = {} m)",
+                num(most.max(0.0)),
+                num(a),
+                num(d_max),
+                num(spec.behind)
+            ),
+        ));
+    }
     p.spans = spans;
     let len = spans as f64 * a;
     let j = ((x0 - (len - spec.ahead - l)) / a).ceil();

@@ -93,7 +93,8 @@ impl Track {
     }
 
     /// Saves the damped nodes' `u_(j-1)` before a step.
-    #[inline]
+    #[cold]
+    #[inline(never)]
     pub(super) fn absorbing_save(&mut self) {
         let Some(a) = self.absorbing.as_deref_mut() else {
             return;
@@ -109,7 +110,8 @@ impl Track {
 
     /// Damps the new state (at `t_(j+1)`, in `z`, `th` after the step's swap) of the
     /// layer's nodes: `u = (u* + gamma u_(j-1)) / (1 + gamma)`.
-    #[inline]
+    #[cold]
+    #[inline(never)]
     pub(super) fn absorbing_apply(&mut self) {
         let Some(a) = self.absorbing.as_deref() else {
             return;

@@ -2,14 +2,15 @@
 //!
 //! The static wheel heights (and side-frame displacements) depend on the track: -1.5336
 //! mm on the default endless track, -1.3811 mm on the thesis' fixed one (two spans from
-//! its end), -1.5973 / -1.6428 mm under a half-car bogie on the endless track. A partner model started at rest on other heights (its
+//! its end), -1.5973 / -1.6439 mm under a half-car bogie on the endless track. A partner model started at rest on other heights (its
 //! start values, its own static state) would hit the rail at its first step. With
 //! `inputs.datum = first_step` (the default) the heights the track receives at its first
 //! communication step are its static state: each input is moved by the fixed offset
 //! `static - first input`, so a partner at rest starts at rest whatever its datum, with
 //! no handshake of parameters (which OSP libcosim cannot connect and ecos breaks).
 //! `absolute` takes the inputs as they are; the partner then takes the track's
-//! `static_wheel_z.*` first.
+//! `static_wheel_z.*` first. An offset within 16 units in the last place is the
+//! partner's rounding of the same heights and is taken as none.
 
 use crate::error::{Error, out_of_range};
 
@@ -47,15 +48,40 @@ impl InputDatum {
 
     /// The displacements (m) the track takes for wheelset `k`'s inputs `raw` (m): until
     /// its offsets are fixed the static ones (the offsets follow the inputs), then the
-    /// inputs moved by the offsets fixed.
-    pub(super) fn apply(&mut self, k: usize, raw: [f64; 2]) -> [f64; 2] {
+    /// inputs moved by the offsets fixed. `set`: the master set these heights now;
+    /// `at_start`: the track has not stepped yet.
+    pub(super) fn apply(&mut self, k: usize, raw: [f64; 2], set: bool, at_start: bool) -> [f64; 2] {
         if !self.relative || k >= self.statics.len() {
             return raw;
         }
         if !self.fixed[k] {
+            let first = !self.given[k];
             self.given[k] = true;
-            self.offsets[k] = [0, 1].map(|s| self.statics[k][s] - raw[s]);
-            return self.statics[k];
+            // Heights the master set before the first step a few units in the last
+            // place off the static ones are the partner's rounding of them (the
+            // roll-plane vehicle recomputes each wheel's from its bounce and roll):
+            // no offset, the heights as they are, so that a partner started on the
+            // published heights runs bit for bit as the monolithic model, which takes
+            // its vehicle's rounding too. Inputs left at their start values, or first
+            // given after a step, stand for the static state exactly, as before.
+            if first || set {
+                self.offsets[k] = [0, 1].map(|s| {
+                    let d = self.statics[k][s] - raw[s];
+                    let ulps = 16.0 * f64::EPSILON * self.statics[k][s].abs().max(raw[s].abs());
+                    if set && at_start && d.abs() <= ulps {
+                        0.0
+                    } else {
+                        d
+                    }
+                });
+            }
+            return [0, 1].map(|s| {
+                if self.offsets[k][s] == 0.0 {
+                    raw[s]
+                } else {
+                    self.statics[k][s]
+                }
+            });
         }
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
     }
@@ -136,17 +162,23 @@ mod tests {
     fn the_first_inputs_stand_for_the_static_state_and_later_ones_move_from_it() {
         let mut d = InputDatum::new(true, vec![[-1.5e-3, -1.6e-3]]);
         // Before the first step every input stands for the static state.
-        assert_eq!(d.apply(0, [-1.38e-3, -1.38e-3]), [-1.5e-3, -1.6e-3]);
-        assert_eq!(d.apply(0, [-1.40e-3, -1.38e-3]), [-1.5e-3, -1.6e-3]);
+        assert_eq!(
+            d.apply(0, [-1.38e-3, -1.38e-3], true, true),
+            [-1.5e-3, -1.6e-3]
+        );
+        assert_eq!(
+            d.apply(0, [-1.40e-3, -1.38e-3], true, true),
+            [-1.5e-3, -1.6e-3]
+        );
         d.fix();
         // After it, the change since the last input before the step.
-        let z = d.apply(0, [-1.50e-3, -1.28e-3]);
+        let z = d.apply(0, [-1.50e-3, -1.28e-3], true, false);
         assert!((z[0] - (-1.5e-3 - 0.1e-3)).abs() < 1e-15, "{z:?}");
         assert!((z[1] - (-1.6e-3 + 0.1e-3)).abs() < 1e-15, "{z:?}");
         // The state continues exactly.
         let mut e = InputDatum::new(true, vec![[0.0; 2]]);
         e.restore(&d.state()).unwrap();
-        assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3]), z);
+        assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3], true, false), z);
         assert!(e.restore(&[2.0, 0.0, 0.0, 0.0]).is_err());
         assert!(e.restore(&[1.0, 0.0]).is_err());
     }
@@ -154,20 +186,40 @@ mod tests {
     #[test]
     fn a_wheelset_first_given_after_the_first_step_starts_from_its_static_state() {
         let mut d = InputDatum::new(true, vec![[-1.5e-3; 2], [-1.6e-3; 2]]);
-        d.apply(0, [-1.38e-3; 2]);
+        d.apply(0, [-1.38e-3; 2], true, true);
         d.fix();
         // Wheelset 2 was not given before the first step: its first input stands for the
         // static state, and it moves from there after the next step.
         assert!(d.follows(1) && !d.follows(0));
-        assert_eq!(d.apply(1, [-1.0e-3; 2]), [-1.6e-3; 2]);
+        assert_eq!(d.apply(1, [-1.0e-3; 2], true, false), [-1.6e-3; 2]);
         d.fix();
-        let z = d.apply(1, [-0.9e-3; 2]);
+        let z = d.apply(1, [-0.9e-3; 2], true, false);
         assert!((z[0] - -1.5e-3).abs() < 1e-15, "{z:?}");
     }
 
     #[test]
     fn absolute_inputs_are_taken_as_they_are() {
         let mut d = InputDatum::new(false, vec![[-1.5e-3; 2]]);
-        assert_eq!(d.apply(0, [-1.38e-3, 0.2]), [-1.38e-3, 0.2]);
+        assert_eq!(d.apply(0, [-1.38e-3, 0.2], true, true), [-1.38e-3, 0.2]);
+    }
+
+    #[test]
+    fn a_partners_rounding_of_the_static_heights_is_no_offset_at_the_start() {
+        // The default endless track's two static heights differ in the last place; the
+        // roll-plane vehicle gives both back rounded alike. Before the first step such
+        // heights are taken as they are (as the monolithic model takes them); a
+        // wheelset first given them after a step keeps its static state exactly.
+        let statics = [-0.0015336282039686896, -0.0015336282039686894];
+        let rounded = [-0.0015336282039686896; 2];
+        let mut d = InputDatum::new(true, vec![statics; 2]);
+        assert_eq!(d.apply(0, rounded, true, true), rounded);
+        // Inputs left at their start values stand for the static state exactly.
+        assert_eq!(d.apply(1, rounded, false, true), statics);
+        d.fix();
+        assert_eq!(d.apply(0, rounded, true, false), rounded);
+        assert_eq!(d.apply(1, rounded, true, false), statics);
+        // A real offset (a partner on another datum) is one, however small the step.
+        let mut e = InputDatum::new(true, vec![statics]);
+        assert_eq!(e.apply(0, [-1.5e-3; 2], true, true), statics);
     }
 }

@@ -53,7 +53,7 @@ pub(super) enum Engine {
     Vehicle(Box<VehicleUnit>),
 }
 
-/// The model of one of the three FMUs ([`Kind`]) behind the FMI 2.0 layer.
+/// The model of one of the FMUs ([`Kind`]) behind the FMI 2.0 layer.
 #[derive(Debug, Clone)]
 pub struct FmuModel {
     pub(super) kind: Kind,
@@ -73,6 +73,9 @@ pub struct FmuModel {
     pub(super) master_end: f64,
     /// A vehicle's first step was checked against its forces at rest.
     pub(super) started: bool,
+    /// `track.spans` set away from its default on the endless track, which sets its own
+    /// length: the value, for the warning at the end of initialisation.
+    pub(super) unused_spans: Option<f64>,
 }
 
 impl FmuModel {
@@ -183,6 +186,18 @@ impl Model for FmuModel {
             Engine::Sim(sim) => ContactWatch::new(sim.wheelsets().len()),
             Engine::Vehicle(_) => ContactWatch::new(0),
         };
+        let spans = values[vr::TRACK_SPANS as usize];
+        let default_spans = table
+            .vars
+            .iter()
+            .find(|v| v.vr == vr::TRACK_SPANS)
+            .map(|v| v.start);
+        let unused_spans = match &engine {
+            Engine::Sim(sim) if sim.scenario().window.is_some() => {
+                (Some(spans) != default_spans).then_some(spans)
+            }
+            _ => None,
+        };
         Ok(FmuModel {
             kind,
             engine,
@@ -193,6 +208,7 @@ impl Model for FmuModel {
             watch,
             master_end: 0.0,
             started: false,
+            unused_spans,
         })
     }
 
@@ -236,27 +252,20 @@ impl Model for FmuModel {
         }
     }
 
-    /// `stopTime` beyond the time the wheel reaches the end of the track.
+    /// `stopTime` beyond the time the wheel reaches the end of the track; `track.spans`
+    /// set on the endless track, which does not use it.
     fn initialised_warning(&self, start: f64, stop: Option<f64>) -> Option<String> {
-        let (stop, sim) = (stop?, self.simulation()?);
-        let t_end = sim.time_at_track_end()?;
-        if stop - start < t_end {
-            return None;
+        let spans = self.unused_spans.map(|n| {
+            format!(
+                "track.spans = {n} is not used: the endless track (track.window.ahead > 0, \
+                 the default since issue 29) sets its own length; track.window.ahead = 0 \
+                 gives the fixed track of track.spans spans"
+            )
+        });
+        match (spans, self.unreachable_stop(start, stop)) {
+            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+            (a, b) => a.or(b),
         }
-        let s = sim.scenario();
-        let spans = match &s.track {
-            TrackSpec::Discrete(t) => {
-                ((s.start_position + s.speed * (stop - start)) / t.sleeper_spacing).ceil() + 2.0
-            }
-            TrackSpec::Lumped(_) => f64::NAN,
-        };
-        Some(format!(
-            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track at \
-             t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
-             stopTime, and the endless track (track.window.ahead > 0, the default; 20 m is \
-             the converged window) any stopTime",
-            start + t_end
-        ))
     }
 
     /// The track-carrying FMUs step on their fixed grid `t_k = k solver.step` and stop
@@ -418,5 +427,30 @@ impl Model for FmuModel {
             Engine::Vehicle(u) => (u.time() + u.carried(), 0.0),
             Engine::Sim(sim) => (sim.time(), 0.5 * sim.dt()),
         }
+    }
+}
+
+impl FmuModel {
+    /// `stopTime` beyond the time the wheel reaches the end of the fixed track.
+    fn unreachable_stop(&self, start: f64, stop: Option<f64>) -> Option<String> {
+        let (stop, sim) = (stop?, self.simulation()?);
+        let t_end = sim.time_at_track_end()?;
+        if stop - start < t_end {
+            return None;
+        }
+        let s = sim.scenario();
+        let spans = match &s.track {
+            TrackSpec::Discrete(t) => {
+                ((s.start_position + s.speed * (stop - start)) / t.sleeper_spacing).ceil() + 2.0
+            }
+            TrackSpec::Lumped(_) => f64::NAN,
+        };
+        Some(format!(
+            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track at \
+             t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
+             stopTime, and the endless track (track.window.ahead > 0, the default; 20 m is \
+             the converged window) any stopTime",
+            start + t_end
+        ))
     }
 }

@@ -131,6 +131,30 @@ fn wheel_inputs_far_into_the_rail_stop_the_run_with_an_error() {
 }
 
 #[test]
+fn track_spans_set_on_the_endless_default_is_named_at_initialisation() {
+    // Issue 29's breaker: a script written for the old default (the fixed track) that
+    // sets track.spans ran the 10 m window silently.
+    let (mut i, log) = instance(Kind::CoupledSystem);
+    i.set_integer(&[vr::TRACK_SPANS], &[600]).unwrap();
+    i.enter_initialization().unwrap();
+    let w = i.exit_initialization().unwrap_err();
+    assert_eq!(w.status, Status::Warning);
+    assert!(
+        w.message.contains("track.spans = 600 is not used")
+            && w.message.contains("track.window.ahead = 0"),
+        "{}",
+        w.message
+    );
+    assert_eq!(log.lock().unwrap().len(), 1);
+    i.do_step(0.0, 1e-3).unwrap();
+    // On the fixed track it is used: no warning.
+    let (mut i, _) = fixed_track_instance(Kind::CoupledSystem);
+    i.set_integer(&[vr::TRACK_SPANS], &[600]).unwrap();
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+}
+
+#[test]
 fn an_unreachable_stop_time_is_named_at_initialisation() {
     let (mut i, log) = fixed_track_instance(Kind::CoupledSystem);
     i.setup_experiment(0.0, Some(2.0)).unwrap();
@@ -279,7 +303,7 @@ fn a_coupled_run_beyond_the_bounds_fails_the_step_that_got_there() {
     // contact): the first impact passes 20 times the static load. The step that ends there returns
     // fmi2Error naming the force and not blaming inputs CoupledSystem has none of;
     // the stopped run's state serialises and restores as stopped.
-    let (mut i, _) = instance(Kind::CoupledSystem);
+    let (mut i, _) = fixed_track_instance(Kind::CoupledSystem);
     i.set_integer(&[vr::TRACK_SPANS, vr::TRACK_RAIL_BETWEEN_NODES], &[60, 2])
         .unwrap();
     i.set_real(

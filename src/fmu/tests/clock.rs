@@ -130,12 +130,13 @@ fn communication_steps_of_any_size_keep_the_fixed_step_scheme() {
     // fixed-step run's at the nearest grid time (bit for bit), at most half a step
     // away from the master's time.
     let spans = 70;
-    let (mut i, _) = instance(Kind::CoupledSystem);
+    let (mut i, _) = fixed_track_instance(Kind::CoupledSystem);
     i.set_integer(&[vr::TRACK_SPANS], &[spans]).unwrap();
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     let critical = real(&mut i, vr::SOLVER_CRITICAL_STEP);
     i.reset().unwrap();
+    i.set_real(&[vr::TRACK_WINDOW_AHEAD], &[0.0]).unwrap();
     i.set_integer(&[vr::TRACK_SPANS], &[spans]).unwrap();
     i.set_real(&[vr::SOLVER_DT], &[0.97 * critical]).unwrap();
     i.enter_initialization().unwrap();
