@@ -15,7 +15,8 @@
 //! the FMUs' old default (the fixed track) against their new one (10 m a side).
 //! `SPEED` (m/s) sets the speed (default 70 km/h).
 //!
-//! With `SPECTRUM=1` each row also names the frequency of the largest line of the
+//! With `WHEN=1` it prints (to stderr) when the leading wheelset's history differs by
+//! more than half its largest difference. With `SPECTRUM=1` each row also names the frequency of the largest line of the
 //! leading wheelset's history difference between 100 Hz and 5 kHz (a Hann-windowed DFT
 //! in 2 Hz steps).
 //! `cargo run --release --example window_study [AHEAD:BEHIND[:LAYER:RATE]]...`
@@ -169,7 +170,7 @@ fn main() {
                 .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
                 .fold(0.0, f64::max);
             if std::env::var("WHEN").is_ok() {
-                let dt = duration / h.len() as f64;
+                let dt = duration / reference.len() as f64;
                 for (j, (a, b)) in h.iter().zip(&reference).enumerate() {
                     if (a[0] - b[0]).abs() > 0.5 * diff {
                         eprintln!("t = {:.4} s: {:.0} N", j as f64 * dt, a[0] - b[0]);
@@ -178,7 +179,10 @@ fn main() {
             }
             let line = if std::env::var("SPECTRUM").is_ok() {
                 let e: Vec<f64> = h.iter().zip(&reference).map(|(a, b)| a[0] - b[0]).collect();
-                format!(" {:.0} Hz |", strongest_line(&e, duration / h.len() as f64))
+                format!(
+                    " {:.0} Hz |",
+                    strongest_line(&e, duration / reference.len() as f64)
+                )
             } else {
                 String::new()
             };

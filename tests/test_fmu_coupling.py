@@ -200,7 +200,7 @@ def test_a_new_users_default_run_goes_on_for_ten_seconds_on_the_endless_track(pa
         near = (t > te - 0.2 * turn) & (t < te + 0.2 * turn)
         assert f[near].max() > 1.8 * load, te
         assert 0.0 <= t[near][np.argmax(f[near])] - te < 2e-3, te
-    # Between impacts the wheel rides at its static load (within 2.6 % of it).
+    # Between impacts the wheel rides at its static load (measured within 2.6 % of it).
     calm = np.ones_like(t, dtype=bool)
     for te in expected:
         calm &= np.abs(t - te) > 0.25 * turn

@@ -1,12 +1,12 @@
-//! Cost of one step of CoupledSystem on the endless track's converged window (or SIDE) with 1 to 4
-//! wheelsets of a four-axle wagon (0, 1.8, 10, 11.8 m), through the C boundary
-//! (fmi2DoStep of solver.step, the contact forces read) against the engine's own step
-//! of the same scenario, for instruction counting:
-//! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS [SIDE]`
+//! Cost of one step of CoupledSystem on the endless track's converged window (or SIDE)
+//! with 1 to 4 wheelsets of a four-axle wagon (0, 1.8, 10, 11.8 m), through the C
+//! boundary (fmi2DoStep of solver.step, the contact forces read) against the engine's
+//! own step of the same scenario, for instruction counting:
+//! `valgrind --tool=callgrind target/release/examples/wagon_step_cost engine|fmu WHEELSETS STEPS [SIDE [K]]`
 //! (subtract a run of 0 steps). SIDE (m) is the window's length ahead and behind
-//! (default: the converged 20 m); 0 runs the fixed 30-span track instead. A fifth
-//! argument K makes each fmi2DoStep K steps long (default 1). Without valgrind it
-//! prints wall time per step.
+//! (default: the converged 20 m); 0 runs the fixed 30-span track instead (one wheelset:
+//! the others would start behind its end). K makes each fmi2DoStep K steps long
+//! (default 1). Without valgrind it prints wall time per step.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -56,7 +56,7 @@ fn main() {
         }
         reals.extend(OFFSET_VRS.iter().copied().zip(WAGON));
         let integers = [(vr::WHEELSETS, wheelsets as i32)];
-        let per_call: u64 = arg(5).and_then(|s| s.parse().ok()).unwrap_or(1);
+        let per_call: u64 = arg(5).and_then(|s| s.parse().ok()).unwrap_or(1).max(1);
         let (c, dt) = ffi_instance::initialised(COUPLED_SYSTEM.guid, &reals, &integers);
         let (n, dt) = (n / per_call, dt * per_call as f64);
         let outputs = [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE];

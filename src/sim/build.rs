@@ -89,12 +89,14 @@ fn time_step_of(
 }
 
 /// Sets `p.spans` to the window `spec` around wheelsets `d_max` (m) long whose leading
-/// one starts at `x0` (m), and places the window: `ceil((ahead + behind + d_max) / a) +
-/// 1` spans, node 0 at the whole span `j = ceil((x0 - (L - ahead)) / a)`, so that at
-/// least `ahead` lies ahead of the leading wheelset and `behind` behind the last.
+/// one starts at `x0` (m), and places the window: `ceil((ahead + behind + 2 layer +
+/// d_max) / a) + 1` spans, node 0 at the whole span `j = ceil((x0 - (L - ahead -
+/// layer)) / a)`, so that at least `ahead` (and the layer beyond it) lies ahead of the
+/// leading wheelset and `behind` behind the last.
 ///
 /// Errors: `ahead` or `behind` below [`MIN_WINDOW_SIDE`] or one sleeper spacing, or not
-/// finite; a window longer than the track may be.
+/// finite; a layer or its rate out of range; pinned rail ends; a window of more rail
+/// segments than [`MAX_RAIL_SEGMENTS`] (named by `track.window.ahead`).
 fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> Result<Window> {
     let a = p.sleeper_spacing;
     positive("track.sleeper_spacing", a, "m")?;
@@ -139,7 +141,7 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
     // track.spans, which it replaces, is not the user's to change here).
     let n = p.nodes_per_span.max(1);
     if spans.saturating_mul(n) > MAX_RAIL_SEGMENTS {
-        let most = (MAX_RAIL_SEGMENTS / n - 1) as f64 * a - d_max - 2.0 * l;
+        let most = (MAX_RAIL_SEGMENTS / n).saturating_sub(1) as f64 * a - d_max - 2.0 * l;
         return Err(out_of_range(
             "track.window.ahead",
             spec.ahead,

@@ -197,9 +197,9 @@ pub struct TrailingWheelset {
 
 /// The window of an endless track: the lengths of track kept ahead of the leading
 /// wheelset and behind the last one. The window spans
-/// `ceil((ahead + behind + d_max) / a) + 1` sleeper spans and moves forward by whole
-/// spans whenever less than `ahead` remains in front of the leading wheelset; new track
-/// enters at rest, and the window's ends are fixed. Sleepers lie at whole multiples of
+/// `ceil((ahead + behind + 2 layer + d_max) / a) + 1` sleeper spans and moves forward by
+/// whole spans whenever less than `ahead` (and the layer) remains in front of the
+/// leading wheelset; new track enters at rest, and the window's rail ends are fixed. Sleepers lie at whole multiples of
 /// the spacing `a` in line coordinates, as on a fixed track starting at 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackWindow {
@@ -221,7 +221,7 @@ pub struct TrackWindow {
 impl TrackWindow {
     /// The converged window: 20 m ahead, 20 m behind (60 spans of table 4.4 for one
     /// wheelset). Against a 600-span fixed track, the reference flat case's peak is
-    /// within 0.001 % and its whole force history within 0.6 % of the static load
+    /// within 0.001 % and its whole force history within 0.53 % of the static load
     /// (`examples/window_study.rs`, `docs/VALIDATION.md`). The waves an impact sends
     /// along the rails come back from the window's fixed ends: 8 m a side gives the
     /// peak within 0.01 % but the history only within 3.5 %.

@@ -67,8 +67,8 @@ impl Track {
         let (dx, nk) = (self.params.dx(), self.nk);
         let len = (nk - 1) as f64 * dx;
         let mut nodes = Vec::new();
-        // The end nodes themselves are held at zero (fixed ends): the layer is the
-        // nodes inside.
+        // The end nodes themselves are the window's boundary (held at zero on the fixed
+        // ends a window has): the layer is the nodes inside.
         for k in 1..nk - 1 {
             let x = k as f64 * dx;
             let depth = (length - x).max(x - (len - length));
@@ -213,24 +213,5 @@ mod tests {
         // 1 kHz (the pinned-pinned band, where a window's error lies) 0.99.
         assert!(r(1) < 0.5, "1.5-3 kHz: {}", r(1));
         assert!(r(0) > 0.9, "0.8-1 kHz: {}", r(0));
-        // A layer of rate 0 is plain track, bit for bit.
-        let mut s = Scenario::table_4_4();
-        s.set_spans(40);
-        let TrackSpec::Discrete(p) = s.track else {
-            unreachable!()
-        };
-        let dt = 1e-5;
-        let (mut t0, mut t1) = (Track::new(p, dt).unwrap(), Track::new(p, dt).unwrap());
-        t1.set_absorbing_ends(5.0, 0.0).unwrap();
-        let load = [PointLoad {
-            rail: 0,
-            position: 10.0,
-            force: 1e5,
-        }];
-        for _ in 0..500 {
-            t0.step(&load);
-            t1.step(&load);
-        }
-        assert_eq!(t0.rail_z(0), t1.rail_z(0));
     }
 }

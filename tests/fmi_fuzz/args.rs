@@ -103,7 +103,7 @@ pub fn step_size(rng: &mut StdRng, valid: bool) -> f64 {
             13 => -rng.random_range(1e-6..1e-3),
             14 => 5e-324,
             15 => 1e9,
-            16 => 1.0,
+            16 => 0.1,
             _ => nasty(rng),
         };
         let subnormal = h > 0.0 && h < 1e-300;

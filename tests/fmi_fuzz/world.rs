@@ -290,7 +290,9 @@ impl World {
         let p = &mut self.slots[i].phase;
         *p = match (call, status) {
             (Call::EnterInitializationMode, 0) => Mirror::Initialization,
-            (Call::ExitInitializationMode, 0) => Mirror::Stepping,
+            // fmi2Warning: initialised, with a warning (a stopTime the fixed track cannot
+            // reach, track.spans set on the endless track).
+            (Call::ExitInitializationMode, 0 | 1) => Mirror::Stepping,
             (Call::Terminate, 0) => Mirror::Terminated,
             (Call::Reset, 0) => Mirror::Instantiated,
             (Call::DoStep, 2) => Mirror::Ended,

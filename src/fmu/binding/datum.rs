@@ -9,8 +9,9 @@
 //! `static - first input`, so a partner at rest starts at rest whatever its datum, with
 //! no handshake of parameters (which OSP libcosim cannot connect and ecos breaks).
 //! `absolute` takes the inputs as they are; the partner then takes the track's
-//! `static_wheel_z.*` first. An offset within 16 units in the last place is the
-//! partner's rounding of the same heights and is taken as none.
+//! `static_wheel_z.*` first. A height the master sets before the first step within 16
+//! machine epsilons of its static one (16 to 32 units in the last place) is the
+//! partner's rounding of it and moves nothing: no offset.
 
 use crate::error::{Error, out_of_range};
 
@@ -47,10 +48,17 @@ impl InputDatum {
     }
 
     /// The displacements (m) the track takes for wheelset `k`'s inputs `raw` (m): until
-    /// its offsets are fixed the static ones (the offsets follow the inputs), then the
-    /// inputs moved by the offsets fixed. `set`: the master set these heights now;
-    /// `at_start`: the track has not stepped yet.
-    pub(super) fn apply(&mut self, k: usize, raw: [f64; 2], set: bool, at_start: bool) -> [f64; 2] {
+    /// its offsets are fixed the static ones (the offsets follow the inputs; a side the
+    /// master set before the first step within the rounding of its static height: the
+    /// input as it is), then the inputs moved by the offsets fixed. `set`: the master
+    /// set that side's height now; `at_start`: the track has not stepped yet.
+    pub(super) fn apply(
+        &mut self,
+        k: usize,
+        raw: [f64; 2],
+        set: [bool; 2],
+        at_start: bool,
+    ) -> [f64; 2] {
         if !self.relative || k >= self.statics.len() {
             return raw;
         }
@@ -64,16 +72,17 @@ impl InputDatum {
             // published heights runs bit for bit as the monolithic model, which takes
             // its vehicle's rounding too. Inputs left at their start values, or first
             // given after a step, stand for the static state exactly, as before.
-            if first || set {
-                self.offsets[k] = [0, 1].map(|s| {
+            for s in 0..2 {
+                if first || set[s] {
                     let d = self.statics[k][s] - raw[s];
-                    let ulps = 16.0 * f64::EPSILON * self.statics[k][s].abs().max(raw[s].abs());
-                    if set && at_start && d.abs() <= ulps {
+                    // 16 machine epsilons of the height: 16 to 32 units in its last place.
+                    let rounding = 16.0 * f64::EPSILON * self.statics[k][s].abs().max(raw[s].abs());
+                    self.offsets[k][s] = if set[s] && at_start && d.abs() <= rounding {
                         0.0
                     } else {
                         d
-                    }
-                });
+                    };
+                }
             }
             return [0, 1].map(|s| {
                 if self.offsets[k][s] == 0.0 {
@@ -163,22 +172,22 @@ mod tests {
         let mut d = InputDatum::new(true, vec![[-1.5e-3, -1.6e-3]]);
         // Before the first step every input stands for the static state.
         assert_eq!(
-            d.apply(0, [-1.38e-3, -1.38e-3], true, true),
+            d.apply(0, [-1.38e-3, -1.38e-3], [true; 2], true),
             [-1.5e-3, -1.6e-3]
         );
         assert_eq!(
-            d.apply(0, [-1.40e-3, -1.38e-3], true, true),
+            d.apply(0, [-1.40e-3, -1.38e-3], [true; 2], true),
             [-1.5e-3, -1.6e-3]
         );
         d.fix();
         // After it, the change since the last input before the step.
-        let z = d.apply(0, [-1.50e-3, -1.28e-3], true, false);
+        let z = d.apply(0, [-1.50e-3, -1.28e-3], [true; 2], false);
         assert!((z[0] - (-1.5e-3 - 0.1e-3)).abs() < 1e-15, "{z:?}");
         assert!((z[1] - (-1.6e-3 + 0.1e-3)).abs() < 1e-15, "{z:?}");
         // The state continues exactly.
         let mut e = InputDatum::new(true, vec![[0.0; 2]]);
         e.restore(&d.state()).unwrap();
-        assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3], true, false), z);
+        assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3], [true; 2], false), z);
         assert!(e.restore(&[2.0, 0.0, 0.0, 0.0]).is_err());
         assert!(e.restore(&[1.0, 0.0]).is_err());
     }
@@ -186,21 +195,24 @@ mod tests {
     #[test]
     fn a_wheelset_first_given_after_the_first_step_starts_from_its_static_state() {
         let mut d = InputDatum::new(true, vec![[-1.5e-3; 2], [-1.6e-3; 2]]);
-        d.apply(0, [-1.38e-3; 2], true, true);
+        d.apply(0, [-1.38e-3; 2], [true; 2], true);
         d.fix();
         // Wheelset 2 was not given before the first step: its first input stands for the
         // static state, and it moves from there after the next step.
         assert!(d.follows(1) && !d.follows(0));
-        assert_eq!(d.apply(1, [-1.0e-3; 2], true, false), [-1.6e-3; 2]);
+        assert_eq!(d.apply(1, [-1.0e-3; 2], [true; 2], false), [-1.6e-3; 2]);
         d.fix();
-        let z = d.apply(1, [-0.9e-3; 2], true, false);
+        let z = d.apply(1, [-0.9e-3; 2], [true; 2], false);
         assert!((z[0] - -1.5e-3).abs() < 1e-15, "{z:?}");
     }
 
     #[test]
     fn absolute_inputs_are_taken_as_they_are() {
         let mut d = InputDatum::new(false, vec![[-1.5e-3; 2]]);
-        assert_eq!(d.apply(0, [-1.38e-3, 0.2], true, true), [-1.38e-3, 0.2]);
+        assert_eq!(
+            d.apply(0, [-1.38e-3, 0.2], [true; 2], true),
+            [-1.38e-3, 0.2]
+        );
     }
 
     #[test]
@@ -212,14 +224,23 @@ mod tests {
         let statics = [-0.0015336282039686896, -0.0015336282039686894];
         let rounded = [-0.0015336282039686896; 2];
         let mut d = InputDatum::new(true, vec![statics; 2]);
-        assert_eq!(d.apply(0, rounded, true, true), rounded);
+        assert_eq!(d.apply(0, rounded, [true; 2], true), rounded);
         // Inputs left at their start values stand for the static state exactly.
-        assert_eq!(d.apply(1, rounded, false, true), statics);
+        assert_eq!(d.apply(1, rounded, [false; 2], true), statics);
         d.fix();
-        assert_eq!(d.apply(0, rounded, true, false), rounded);
-        assert_eq!(d.apply(1, rounded, true, false), statics);
-        // A real offset (a partner on another datum) is one, however small the step.
+        assert_eq!(d.apply(0, rounded, [true; 2], false), rounded);
+        assert_eq!(d.apply(1, rounded, [true; 2], false), statics);
+        // A real offset (a partner on another datum) is one, from 64 units in the last
+        // place on.
         let mut e = InputDatum::new(true, vec![statics]);
-        assert_eq!(e.apply(0, [-1.5e-3; 2], true, true), statics);
+        assert_eq!(e.apply(0, [-1.5e-3; 2], [true; 2], true), statics);
+        let off = statics.map(|z| z * (1.0 + 64.0 * f64::EPSILON));
+        assert_eq!(e.apply(0, off, [true; 2], true), statics);
+        // A side the master did not set keeps its static height exactly.
+        let mut f = InputDatum::new(true, vec![statics]);
+        assert_eq!(
+            f.apply(0, rounded, [true, false], true),
+            [rounded[0], statics[1]]
+        );
     }
 }

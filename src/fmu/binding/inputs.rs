@@ -97,7 +97,7 @@ impl FmuModel {
                     let frames = std::iter::once(FRAME_VRS).chain(TRAILING_FRAME_VRS);
                     for (k, [zl, zr, vl, vr_]) in frames.take(n).enumerate() {
                         if changed_any(zl, zr) || changed_any(vl, vr_) {
-                            let set = changed_any(zl, zr);
+                            let set = [changed.contains(&zl), changed.contains(&zr)];
                             let z = self.datum.apply(k, [v(zl), v(zr)], set, sim.steps() == 0);
                             sim.set_side_frames_of(k, z, [v(vl), v(vr_)])?;
                         }
@@ -110,7 +110,7 @@ impl FmuModel {
                 let lead = [vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z, vr::WHEEL_ROTATION];
                 let refs = std::iter::once(lead).chain(TRAILING_INPUT_VRS);
                 for (k, r) in refs.take(n).enumerate() {
-                    let set = changed_any(r[0], r[1]);
+                    let set = [changed.contains(&r[0]), changed.contains(&r[1])];
                     let z = self
                         .datum
                         .apply(k, [v(r[0]), v(r[1])], set, sim.steps() == 0);

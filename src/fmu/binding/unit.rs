@@ -262,10 +262,8 @@ impl Model for FmuModel {
                  gives the fixed track of track.spans spans"
             )
         });
-        match (spans, self.unreachable_stop(start, stop)) {
-            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
-            (a, b) => a.or(b),
-        }
+        // The fixed track's stop time and the endless track's spans never meet.
+        spans.or_else(|| self.unreachable_stop(start, stop))
     }
 
     /// The track-carrying FMUs step on their fixed grid `t_k = k solver.step` and stop
