@@ -154,9 +154,25 @@ fn main() {
     }
     println!();
     let peak = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let largest = fixed.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // How long the echo rings: the first and the last time it exceeds 1e-2 and 1e-3 of
+    // its largest value (what an exact boundary's memory would have to span).
+    let span = |f: f64| {
+        let above: Vec<usize> = (0..fixed.len())
+            .filter(|&i| fixed[i].abs() > f * largest)
+            .collect();
+        (
+            above[0] as f64 * dt * 1e3,
+            above[above.len() - 1] as f64 * dt * 1e3,
+        )
+    };
+    let (a2, b2) = span(1e-2);
+    let (a3, b3) = span(1e-3);
     println!(
-        "end {l} m from the load; echo of the fixed end, largest {:.2} % of the direct peak",
-        100.0 * fixed.iter().fold(0.0f64, |m, x| m.max(x.abs())) / peak
+        "end {l} m from the load; echo of the fixed end, largest {:.2} % of the direct \
+         peak; above 1 % of its largest from {a2:.1} to {b2:.1} ms, above 0.1 % from \
+         {a3:.1} to {b3:.1} ms",
+        100.0 * largest / peak
     );
     print!("| layer (m) | rate (1/s) |");
     for b in 0..BANDS.len() - 1 {
