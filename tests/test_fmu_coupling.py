@@ -43,14 +43,19 @@ def test_pair_at_comm_step_dt_equals_coupled_system(paths):
     assert pair["contact.left.max_force"][-1] == pytest.approx(peak, rel=1e-12)
 
 
-def test_coupled_system_reproduces_the_runner(paths, tmp_path):
+@pytest.mark.parametrize("flags, params", [
+    # The runner's preset is the thesis' fixed 30-span track, one parameter away from
+    # the FMUs' default endless track ...
+    ([], {"track.window.ahead": 0.0}),
+    # ... which is the runner's --window 10.
+    (["--window", "10"], {}),
+])
+def test_coupled_system_reproduces_the_runner(paths, tmp_path, flags, params):
     csv = tmp_path / "runner.csv"
     subprocess.run([os.path.join(wf.TARGET_DIR, "release", "wheelflat"), "--duration", "0.1",
-                    "--output", str(csv)], check=True, capture_output=True, cwd=wf.ROOT)
+                    "--output", str(csv), *flags], check=True, capture_output=True, cwd=wf.ROOT)
     runner = np.genfromtxt(csv, delimiter=",", names=True)
-    # The runner's preset is the thesis' fixed 30-span track, one parameter away from
-    # the FMUs' default endless track.
-    u = initialised(paths, "CoupledSystem", params={"track.window.ahead": 0.0})
+    u = initialised(paths, "CoupledSystem", params=params)
     h = u.get("solver.step")[0]
     forces = []
     for k in range(len(runner)):

@@ -4,15 +4,18 @@
 //! wheelflat [--preset table4.4-flat] [--speed KMH] [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:chord]]...
 //!           [--no-flats] [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5]
 //!           [--n NODES_PER_SPAN] [--between-nodes beam|linear] [--dt-us US] [--spans N]
-//!           [--start M] [--site M]... [--duration S]
+//!           [--window AHEAD[:BEHIND]] [--start M] [--site M]... [--duration S]
 //!           [--every K] [--output FILE.csv]
 //! ```
+//!
+//! The presets are the thesis' fixed tracks; `--window 10` runs the FMUs' default, the
+//! endless track with 10 m kept ahead and behind (`--window 20`: the converged window).
 
 use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 use wheelflat::contact::ContactModel;
-use wheelflat::sim::{Scenario, Simulation, kmh};
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, kmh};
 use wheelflat::track::RailBetweenNodes;
 use wheelflat::wheel::{FlatShape, FlatSpec};
 
@@ -20,8 +23,10 @@ const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:haversine|chord]]... [--no-flats] \
 [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5] [--n NODES_PER_SPAN] \
 [--between-nodes beam|linear] [--dt-us US] \
-[--spans N] [--start M] [--site M]... [--duration S] [--every K] [--output FILE.csv]
-presets: table4.4 table4.4-flat (default) table4.1 table5.1 table5.2 chapter2";
+[--spans N] [--window AHEAD[:BEHIND]] [--start M] [--site M]... [--duration S] [--every K] \
+[--output FILE.csv]
+presets (the thesis' fixed tracks): table4.4 table4.4-flat (default) table4.1 table5.1 \
+table5.2 chapter2; --window 10: the FMUs' default endless track";
 
 fn num(flag: &str, v: Option<String>) -> Result<f64, String> {
     let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
@@ -133,6 +138,18 @@ fn run() -> Result<(), String> {
                 scenario.set_spans(n as usize)
             }
             "--dt-us" => scenario.dt = num(&flag, v)? * 1e-6,
+            "--window" => {
+                let v = v.ok_or("--window needs a value (m): AHEAD[:BEHIND]")?;
+                let (ahead, behind) = match v.split_once(':') {
+                    Some((a, b)) => (a.to_string(), b.to_string()),
+                    None => (v.clone(), v.clone()),
+                };
+                scenario.window = Some(TrackWindow {
+                    ahead: num(&flag, Some(ahead))?,
+                    behind: num(&flag, Some(behind))?,
+                    ..TrackWindow::DEFAULT
+                });
+            }
             "--start" => scenario.start_position = num(&flag, v)?,
             "--site" => scenario.sites.push(num(&flag, v)?),
             "--duration" => duration = num(&flag, v)?,
