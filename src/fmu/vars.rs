@@ -106,6 +106,11 @@ pub static FMUS: [&FmuTable; 5] = [
 pub const C_HEADER: &str = include_str!(concat!(env!("OUT_DIR"), "/wheelflat_fmi2.h"));
 
 impl FmuTable {
+    /// The variable of value reference `vr`; `None` when the FMU has none.
+    pub fn var(&self, vr: u32) -> Option<&VarSpec> {
+        self.vars.iter().find(|v| v.vr == vr)
+    }
+
     /// The value references of the inputs, in ModelVariables order.
     pub fn inputs(&self) -> impl Iterator<Item = u32> + '_ {
         self.vars

@@ -166,7 +166,7 @@ pub fn refs(rng: &mut StdRng, table: &FmuTable, want: Option<VarType>, valid: bo
 pub fn spec(table: &FmuTable, r: u32) -> Option<&'static VarSpec> {
     FMUS.iter()
         .find(|t| t.model_identifier == table.model_identifier)
-        .and_then(|t| t.vars.iter().find(|v| v.vr == r))
+        .and_then(|t| (*t).var(r))
 }
 
 impl World {

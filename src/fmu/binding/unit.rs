@@ -187,11 +187,7 @@ impl Model for FmuModel {
             Engine::Vehicle(_) => ContactWatch::new(0),
         };
         let spans = values[vr::TRACK_SPANS as usize];
-        let default_spans = table
-            .vars
-            .iter()
-            .find(|v| v.vr == vr::TRACK_SPANS)
-            .map(|v| v.start);
+        let default_spans = table.var(vr::TRACK_SPANS).map(|v| v.start);
         let unused_spans = match &engine {
             Engine::Sim(sim) if sim.scenario().window.is_some() => {
                 (Some(spans) != default_spans).then_some(spans)
