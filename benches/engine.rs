@@ -9,8 +9,7 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 mod ffi_instance;
 use std::hint::black_box;
 use wheelflat::contact::ContactLaw;
-use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec};
-use wheelflat::vehicle::WagonParams;
+use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
 use wheelflat::wheel::{FlatSpec, WheelProfile};
 
 /// Simulated time per benchmark iteration of the scaling and FMU groups (s).
@@ -201,14 +200,7 @@ fn endless_track(c: &mut Criterion) {
     }
     // The whole wagon (vehicle.model = wagon): the car body on two half-car bogies over
     // the same four wheelsets.
-    let wagon = {
-        let mut s = endless(4, side).scenario().clone();
-        let VehicleSpec::RollPlane(p) = s.vehicle else {
-            unreachable!("the preset has the roll-plane vehicle")
-        };
-        s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, WAGON[1], WAGON[0], 180.0));
-        Simulation::new(&s).unwrap()
-    };
+    let wagon = Simulation::new(&Scenario::table_4_4_wagon()).unwrap();
     g.bench_with_input(
         BenchmarkId::new("wagon_vehicle_converged_window", 4),
         &wagon,

@@ -9,8 +9,7 @@
 //! side, issue 29).
 //! `cargo run --release --example wagon_memory [roll_plane|one]`
 use std::time::Instant;
-use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec};
-use wheelflat::vehicle::WagonParams;
+use wheelflat::sim::{Scenario, Simulation, TrackWindow};
 
 fn peak_rss_kib() -> u64 {
     let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
@@ -22,23 +21,14 @@ fn peak_rss_kib() -> u64 {
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_default();
-    let mut s = Scenario::table_4_4_flat();
-    s.window = Some(TrackWindow::CONVERGED);
-    s.trailing = [1.8, 10.0, 11.8]
-        .iter()
-        .map(|&offset| TrailingWheelset {
-            offset,
-            ..Default::default()
-        })
-        .collect();
-    if which == "one" {
-        s.window = Some(TrackWindow::DEFAULT);
-        s.trailing.clear();
-    } else if which != "roll_plane" {
-        let VehicleSpec::RollPlane(p) = s.vehicle else {
-            unreachable!("the preset has the roll-plane vehicle")
-        };
-        s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
+    let mut s = Scenario::table_4_4_wagon();
+    match which.as_str() {
+        "one" => {
+            s = Scenario::table_4_4_flat();
+            s.window = Some(TrackWindow::DEFAULT);
+        }
+        "roll_plane" => s.vehicle = Scenario::table_4_4_flat().vehicle,
+        _ => {}
     }
     let before = peak_rss_kib();
     let mut sim = Simulation::new(&s).unwrap();

@@ -4,10 +4,9 @@
 //! monolithic run, and a long run at constant memory.
 
 use wheelflat::sim::{
-    Scenario, Simulation, TrackWindow, TrailingWheelset, UnitModel, VehicleSpec, VehicleUnit,
-    VehicleUnitParams,
+    Scenario, Simulation, UnitModel, VehicleSpec, VehicleUnit, VehicleUnitParams,
 };
-use wheelflat::vehicle::{HalfCarParams, RollPlaneParams, WagonParams};
+use wheelflat::vehicle::{HalfCarParams, RollPlaneParams};
 
 fn roll_plane(s: &Scenario) -> RollPlaneParams {
     match s.vehicle {
@@ -18,19 +17,9 @@ fn roll_plane(s: &Scenario) -> RollPlaneParams {
 
 /// Table 4.4 with the wagon (1.8 m wheelbase, bogie centres 10 m apart, side frames of
 /// 180 kg m^2), the flat of the reference run on the leading wheel, 70 km/h, an
-/// endless track.
+/// endless track: [`Scenario::table_4_4_wagon`].
 fn wagon_scenario() -> Scenario {
-    let mut s = Scenario::table_4_4_flat();
-    let w = WagonParams::table_4_4(&roll_plane(&s), 10.0, 1.8, 180.0);
-    s.vehicle = VehicleSpec::Wagon(w);
-    s.trailing = [1.8, 10.0, 11.8]
-        .map(|offset| TrailingWheelset {
-            offset,
-            ..Default::default()
-        })
-        .to_vec();
-    s.window = Some(TrackWindow::CONVERGED);
-    s
+    Scenario::table_4_4_wagon()
 }
 
 /// The largest contact force of each wheel `[left, right]` of every wheelset over

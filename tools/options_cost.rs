@@ -18,7 +18,7 @@ use wheelflat::sim::{
     Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
 use wheelflat::track::{RailDefect, SupportLaw, Supports};
-use wheelflat::vehicle::{HalfCarParams, WagonParams};
+use wheelflat::vehicle::HalfCarParams;
 use wheelflat::wheel::OutOfRoundness;
 
 fn main() {
@@ -83,19 +83,7 @@ fn main() {
             }];
             s.window = Some(TrackWindow::CONVERGED);
         }
-        "wagon" => {
-            let VehicleSpec::RollPlane(p) = s.vehicle else {
-                unreachable!()
-            };
-            s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
-            s.trailing = [1.8, 10.0, 11.8]
-                .map(|offset| TrailingWheelset {
-                    offset,
-                    ..Default::default()
-                })
-                .to_vec();
-            s.window = Some(TrackWindow::CONVERGED);
-        }
+        "wagon" => s = Scenario::table_4_4_wagon(),
         other => panic!("unknown option {other}"),
     }
     let mut sim = Simulation::new(&s).unwrap();

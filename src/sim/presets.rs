@@ -9,10 +9,12 @@
 //!   other table and below what (2.25) gives for a usual Hertz coefficient
 //!   (it implies C_H ~ 1.0e10 N/m^1.5); the printed value is kept.
 
-use super::scenario::{DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, VehicleSpec, kmh};
+use super::scenario::{
+    DEFAULT_NODES_PER_SPAN, Scenario, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, kmh,
+};
 use crate::contact::ContactModel;
 use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
-use crate::vehicle::{LumpedTrackParams, LumpedWheelParams, RollPlaneParams};
+use crate::vehicle::{LumpedTrackParams, LumpedWheelParams, RollPlaneParams, WagonParams};
 use crate::wheel::FlatSpec;
 
 /// The track of tables 4.1 and 4.4 with `spans` sleeper spans at the default grid.
@@ -85,6 +87,27 @@ impl Scenario {
             0.0015,
             std::f64::consts::FRAC_PI_2,
         ));
+        s
+    }
+
+    /// The four-axle wagon of table 4.4 (`WagonParams::table_4_4`: bogie centres 10 m
+    /// apart, 1.8 m wheelbases, side frames of 180 kg m^2 in pitch) on wheelsets 0, 1.8,
+    /// 10 and 11.8 m behind the leading one, the reference flat on the leading left
+    /// wheel, 70 km/h, on the endless track's converged window (issue 28's case).
+    pub fn table_4_4_wagon() -> Scenario {
+        let mut s = Scenario::table_4_4_flat();
+        s.name = "table 4.4 wagon, 100 mm x 1.5 mm flat on the leading left wheel".into();
+        let VehicleSpec::RollPlane(p) = s.vehicle else {
+            unreachable!("table 4.4 has the roll-plane vehicle")
+        };
+        s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
+        s.trailing = [1.8, 10.0, 11.8]
+            .map(|offset| TrailingWheelset {
+                offset,
+                ..Default::default()
+            })
+            .to_vec();
+        s.window = Some(TrackWindow::CONVERGED);
         s
     }
 
