@@ -17,6 +17,9 @@
 use wheelflat::sim::{Scenario, Simulation, TrackSpec};
 use wheelflat::track::{PointLoad, Track, TrackParams};
 
+#[path = "../tools/spectrum.rs"]
+mod spectrum;
+
 const BANDS: [f64; 10] = [
     0.0, 100.0, 200.0, 400.0, 700.0, 800.0, 1000.0, 1500.0, 3000.0, 5000.0,
 ];
@@ -74,14 +77,8 @@ fn response(spans: usize, j: usize, ell: f64, eta: f64, duration: f64) -> (Vec<f
 /// Energy of `e` in each band: a plain DFT over the band's bins of `e` under a Hann
 /// window (the records end while the slowest waves still ring), zero-padded to 2x.
 fn band_energy(e: &[f64], dt: f64) -> Vec<f64> {
-    let m = e.len() as f64;
-    let e: Vec<f64> = e
-        .iter()
-        .enumerate()
-        .map(|(i, x)| x * 0.5 * (1.0 - (2.0 * std::f64::consts::PI * i as f64 / m).cos()))
-        .collect();
-    let n = 2 * e.len();
-    let df = 1.0 / (n as f64 * dt);
+    let w = spectrum::hann(e);
+    let df = 1.0 / (2.0 * w.len() as f64 * dt);
     (0..BANDS.len() - 1)
         .map(|b| {
             let (k0, k1) = (
@@ -89,16 +86,7 @@ fn band_energy(e: &[f64], dt: f64) -> Vec<f64> {
                 (BANDS[b + 1] / df) as usize,
             );
             (k0.max(1)..k1)
-                .map(|k| {
-                    let w = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-                    let (mut re, mut im) = (0.0, 0.0);
-                    for (i, x) in e.iter().enumerate() {
-                        let (s, c) = (w * i as f64).sin_cos();
-                        re += x * c;
-                        im -= x * s;
-                    }
-                    re * re + im * im
-                })
+                .map(|k| spectrum::power(&w, dt, k as f64 * df))
                 .sum()
         })
         .collect()

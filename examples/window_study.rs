@@ -23,6 +23,9 @@
 use std::time::Instant;
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset};
 
+#[path = "../tools/spectrum.rs"]
+mod spectrum;
+
 /// Left-wheel force history of every wheelset (N), one row per step.
 fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
     let mut sim = Simulation::new(s).unwrap();
@@ -47,25 +50,10 @@ fn history(s: &Scenario, duration: f64) -> (Vec<Vec<f64>>, f64) {
 /// Frequency (Hz) of the largest line of `e` (sampled every `dt` s) between 100 Hz and
 /// 5 kHz: a Hann-windowed DFT in 2 Hz steps.
 fn strongest_line(e: &[f64], dt: f64) -> f64 {
-    use std::f64::consts::PI;
-    let m = e.len() as f64;
-    let w: Vec<f64> = e
-        .iter()
-        .enumerate()
-        .map(|(i, x)| x * 0.5 * (1.0 - (2.0 * PI * i as f64 / m).cos()))
-        .collect();
-    let power = |f: f64| {
-        let (mut re, mut im) = (0.0, 0.0);
-        for (i, x) in w.iter().enumerate() {
-            let (s, c) = (2.0 * PI * f * i as f64 * dt).sin_cos();
-            re += x * c;
-            im -= x * s;
-        }
-        re * re + im * im
-    };
+    let w = spectrum::hann(e);
     (50..2500)
         .map(|k| 2.0 * k as f64)
-        .map(|f| (f, power(f)))
+        .map(|f| (f, spectrum::power(&w, dt, f)))
         .fold((0.0, f64::MIN), |a, b| if b.1 > a.1 { b } else { a })
         .0
 }

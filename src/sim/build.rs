@@ -11,7 +11,7 @@ use super::static_start::{contact_law, static_loads};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::ContactLaw;
-use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
+use crate::error::{Error, Result, finite, num, out_of_range, positive};
 use crate::limits::{MAX_RAIL_SEGMENTS, MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{PointLoad, RailEnds, RailProfile, SimdLevel, Track, TrackParams};
@@ -126,7 +126,6 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
             format!("0 m <= track.window.layer <= {MAX_WINDOW_SIDE} m"),
         ));
     }
-    non_negative("track.window.layer_rate", spec.layer_rate, "1/s")?;
     if p.ends != RailEnds::Fixed {
         return Err(Error::Unsupported(
             "a moving window on a track with pinned ends (track.window.ahead > 0 needs the \
@@ -268,9 +267,8 @@ impl Simulation {
                     }
                 }
                 let mut t = Track::new(*p, dt)?;
-                if let Some(w) = &window
-                    && w.spec.layer > 0.0
-                {
+                if let Some(w) = &window {
+                    // Checks the rate too, with or without a layer.
                     t.set_absorbing_ends(w.spec.layer, w.spec.layer_rate)?;
                 }
                 TrackState::Discrete(t)

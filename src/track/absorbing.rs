@@ -57,9 +57,7 @@ impl Track {
                 format!("0 to half the track, {} m", crate::error::num(half)),
             ));
         }
-        if !(rate.is_finite() && rate >= 0.0) {
-            return Err(out_of_range("track.window.layer_rate", rate, ">= 0 1/s"));
-        }
+        crate::error::non_negative("track.window.layer_rate", rate, "1/s")?;
         if length == 0.0 {
             self.absorbing = None;
             return Ok(());
@@ -136,8 +134,14 @@ impl Track {
     }
 }
 
+// The window examples' spectra (a Hann window, one DFT term), for the test below.
+#[cfg(test)]
+#[path = "../../tools/spectrum.rs"]
+mod spectrum;
+
 #[cfg(test)]
 mod tests {
+    use super::spectrum;
     use super::*;
     use crate::sim::{Scenario, Simulation, TrackSpec};
     use std::f64::consts::PI;
@@ -176,20 +180,10 @@ mod tests {
 
     /// Energy of `e` (under a Hann window) between `f0` and `f1` (Hz).
     fn band(e: &[f64], dt: f64, f0: f64, f1: f64) -> f64 {
-        let m = e.len() as f64;
-        let df = 1.0 / (m * dt);
+        let w = spectrum::hann(e);
+        let df = 1.0 / (w.len() as f64 * dt);
         ((f0 / df).ceil() as usize..(f1 / df) as usize)
-            .map(|k| {
-                let w = 2.0 * PI * k as f64 / m;
-                let (mut re, mut im) = (0.0, 0.0);
-                for (i, x) in e.iter().enumerate() {
-                    let h = 0.5 * (1.0 - (2.0 * PI * i as f64 / m).cos());
-                    let (s, c) = (w * i as f64).sin_cos();
-                    re += h * x * c;
-                    im -= h * x * s;
-                }
-                re * re + im * im
-            })
+            .map(|k| spectrum::power(&w, dt, k as f64 * df))
             .sum()
     }
 
