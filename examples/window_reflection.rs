@@ -12,7 +12,8 @@
 //! `|R(f)| = |E_layer(f)| / |E_fixed(f)|`, given per band as the ratio of the echoes'
 //! energies' square roots. A layer of rate 0 is that much more plain track, the
 //! comparison that counts: a layer is worth having where it reflects less than the
-//! plain track of its length. Default: `L` = 8 m, layers of 8, 20 and 40 m.
+//! plain track of its length. Default: `L` = 8 m, layers of 8, 20 and 40 m, and last
+//! (`0:-1`) the exact ends of `Track::set_exact_ends` remembering the whole record.
 //! `cargo run --release --example window_reflection [L [ell:eta]...]`
 use wheelflat::sim::{Scenario, Simulation, TrackSpec};
 use wheelflat::track::{PointLoad, Track, TrackParams};
@@ -42,12 +43,15 @@ fn response(spans: usize, j: usize, ell: f64, eta: f64, duration: f64) -> (Vec<f
     let (p, dt) = params(spans);
     let a = p.sleeper_spacing;
     let mut t = Track::new(p, dt).unwrap();
-    if ell > 0.0 {
+    let n = (duration / dt).round() as usize;
+    if eta < 0.0 {
+        // Exact ends remembering the whole record.
+        t.set_exact_ends(n).unwrap();
+    } else if ell > 0.0 {
         t.set_absorbing_ends(ell, eta).unwrap();
     }
     let x = (j as f64 + 0.5) * a;
     let pulse = 1e-4;
-    let n = (duration / dt).round() as usize;
     let mut u = Vec::with_capacity(n);
     for k in 0..n {
         let tk = k as f64 * dt;
@@ -117,6 +121,7 @@ fn main() {
             (40.0, 0.0),
             (40.0, 30.0),
             (40.0, 100.0),
+            (0.0, -1.0),
         ];
     }
     let a = params(30).0.sleeper_spacing;
@@ -124,7 +129,7 @@ fn main() {
     let (reference, dt) = response(2 * far, far, 0.0, 0.0, duration);
     let echo = |ell: f64, eta: f64| {
         // The load L m from the end of the plain track (ell m more with the layer).
-        let j = ((l + ell) / a).floor() as usize;
+        let j = ((l + ell.max(0.0)) / a).floor() as usize;
         let (u, _) = response(j + far, j, ell, eta, duration);
         // The reference's load is at span `far`, the window's at `j`: the same place
         // between sleepers, so the direct responses are the same.

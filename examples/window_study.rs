@@ -6,8 +6,10 @@
 //! sleepers). Prints, per window: the largest force of each wheelset against the
 //! reference's, the largest difference of the whole force history over the static
 //! load, and the wall time. A window `AHEAD:BEHIND:LAYER:RATE` adds absorbing layers of
-//! LAYER m with the largest damping rate RATE (1/s) beyond both sides (issue 29); the
-//! window `0:0` is the thesis' fixed 30-span track instead.
+//! LAYER m with the largest damping rate RATE (1/s) beyond both sides (issue 29);
+//! `AHEAD:BEHIND:0:0:MEMORY` makes the window's ends exact with MEMORY s of memory
+//! (`TrackWindow::exact_memory`); the window `0:0` is the thesis' fixed 30-span track
+//! instead.
 //!
 //! With `DEFAULT_START=1` the runs start where the FMUs start (1.37 m, two spans from
 //! the fixed track's end) and last `DURATION` s (then 0.95 s: the wheel's whole run on
@@ -15,7 +17,8 @@
 //! the FMUs' old default (the fixed track) against their new one (10 m a side).
 //! `SPEED` (m/s) sets the speed (default 70 km/h).
 //!
-//! With `WHEN=1` it prints (to stderr) when the leading wheelset's history differs by
+//! With `BINS=1` it prints (to stderr) the largest difference of the leading wheelset's
+//! force (N) in every 5 ms of the run. With `WHEN=1` it prints (to stderr) when the leading wheelset's history differs by
 //! more than half its largest difference. With `SPECTRUM=1` each row also names the frequency of the largest line of the
 //! leading wheelset's history difference between 100 Hz and 5 kHz (a Hann-windowed DFT
 //! in 2 Hz steps).
@@ -65,14 +68,17 @@ fn main() {
         .map_or(if default_start { 0.95 } else { 1.0 }, |v| {
             v.parse().expect("DURATION")
         });
-    let mut windows: Vec<(f64, f64, f64, f64)> = std::env::args()
+    let mut windows: Vec<(f64, f64, f64, f64, f64)> = std::env::args()
         .skip(1)
         .map(|a| {
             let v: Vec<f64> = a.split(':').map(|x| x.parse().expect("a number")).collect();
             match v[..] {
-                [x, y] => (x, y, 0.0, 0.0),
-                [x, y, l, r] => (x, y, l, r),
-                _ => panic!("AHEAD:BEHIND or AHEAD:BEHIND:LAYER:RATE"),
+                [x, y] => (x, y, 0.0, 0.0, 0.0),
+                [x, y, l, r] => (x, y, l, r, 0.0),
+                [x, y, l, r, m] => (x, y, l, r, m),
+                _ => panic!(
+                    "AHEAD:BEHIND, AHEAD:BEHIND:LAYER:RATE or AHEAD:BEHIND:LAYER:RATE:MEMORY"
+                ),
             }
         })
         .collect();
@@ -83,7 +89,7 @@ fn main() {
             [4.0, 8.0, 12.0, 16.0, 20.0, 30.0].to_vec()
         }
         .into_iter()
-        .map(|x| (x, x, 0.0, 0.0))
+        .map(|x| (x, x, 0.0, 0.0, 0.0))
         .collect();
     }
     let cases: &[bool] = if default_start {
@@ -131,16 +137,17 @@ fn main() {
             wall
         );
         println!(
-            "| ahead (m) | behind (m) | layer (m) | rate (1/s) | spans | peak error per wheelset (%) | largest history difference / static load (%) | wall (s) |"
+            "| ahead (m) | behind (m) | layer (m) | rate (1/s) | exact ends' memory (s) | spans | peak error per wheelset (%) | largest history difference / static load (%) | wall (s) |"
         );
-        println!("|---|---|---|---|---|---|---|---|");
-        for &(ahead, behind, layer, layer_rate) in &windows {
+        println!("|---|---|---|---|---|---|---|---|---|");
+        for &(ahead, behind, layer, layer_rate, exact_memory) in &windows {
             let mut s = base.clone();
             s.window = (ahead > 0.0).then_some(TrackWindow {
                 ahead,
                 behind,
                 layer,
                 layer_rate,
+                exact_memory,
             });
             let spans = Simulation::new(&s).unwrap().rail_nodes() / 2 / 8;
             let (h, wall) = history(&s, duration);
@@ -157,6 +164,20 @@ fn main() {
                 .zip(&reference)
                 .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
                 .fold(0.0, f64::max);
+            if std::env::var("BINS").is_ok() {
+                let dt = duration / reference.len() as f64;
+                let b = (0.005 / dt) as usize;
+                let mut line = String::new();
+                for (i, c) in h.chunks(b).zip(reference.chunks(b)).enumerate() {
+                    let m =
+                        c.0.iter()
+                            .zip(c.1)
+                            .map(|(a, b)| (a[0] - b[0]).abs())
+                            .fold(0.0, f64::max);
+                    line += &format!(" {}:{:.0}", i * 5, m);
+                }
+                eprintln!("{line}");
+            }
             if std::env::var("WHEN").is_ok() {
                 let dt = duration / reference.len() as f64;
                 for (j, (a, b)) in h.iter().zip(&reference).enumerate() {
@@ -183,7 +204,7 @@ fn main() {
                 String::new()
             };
             println!(
-                "| {ahead} | {behind} | {layer} | {layer_rate} | {spans}{until} | {} | {:.3} | {wall:.2} |{line}",
+                "| {ahead} | {behind} | {layer} | {layer_rate} | {exact_memory} | {spans}{until} | {} | {:.3} | {wall:.2} |{line}",
                 errs.join(", "),
                 100.0 * diff / load
             );

@@ -126,6 +126,14 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
             format!("0 m <= track.window.layer <= {MAX_WINDOW_SIDE} m"),
         ));
     }
+    finite("track.window.exact_memory", spec.exact_memory, "s")?;
+    if !(0.0..=MAX_EXACT_MEMORY_S).contains(&spec.exact_memory) {
+        return Err(out_of_range(
+            "track.window.exact_memory",
+            spec.exact_memory,
+            format!("0 s <= track.window.exact_memory <= {MAX_EXACT_MEMORY_S} s"),
+        ));
+    }
     if p.ends != RailEnds::Fixed {
         return Err(Error::Unsupported(
             "a moving window on a track with pinned ends (track.window.ahead > 0 needs the \
@@ -169,6 +177,11 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
 
 /// Longest window side (m) ([`TrackWindow`]).
 pub const MAX_WINDOW_SIDE: f64 = 1000.0;
+
+/// The largest memory of exact window ends, [`TrackWindow::exact_memory`] (s): 1 s
+/// (69,400 steps at the converged default step; the track's own limit is
+/// [`crate::track::MAX_EXACT_MEMORY`] steps).
+pub const MAX_EXACT_MEMORY_S: f64 = 1.0;
 /// Shortest window side (m) ([`TrackWindow`]): at 4 m a side the reference flat's peak
 /// is off by 0.12 % and its force history by 16 % of the static load
 /// (`examples/window_study.rs`); shorter windows are further off.
@@ -270,6 +283,7 @@ impl Simulation {
                 if let Some(w) = &window {
                     // Checks the rate too, with or without a layer.
                     t.set_absorbing_ends(w.spec.layer, w.spec.layer_rate)?;
+                    t.set_exact_ends((w.spec.exact_memory / dt).round() as usize)?;
                 }
                 TrackState::Discrete(t)
             }

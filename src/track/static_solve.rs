@@ -135,6 +135,9 @@ impl Track {
     /// Puts the track in static equilibrium under `loads` (the same discrete equations
     /// with zero accelerations and velocities), solved directly.
     pub fn set_static(&mut self, loads: &[PointLoad]) -> Result<()> {
+        if self.exact.is_some() {
+            return self.set_static_exact(loads);
+        }
         let n = self.static_size();
         let nk = self.nk;
         let mut f = DVector::<f64>::zeros(n);

@@ -92,6 +92,8 @@ pub struct Track {
     pub(super) unilateral: Option<Box<Unilateral>>,
     /// A graded damping layer at the rail ends ([`Track::set_absorbing_ends`]).
     pub(super) absorbing: Option<Box<absorbing::AbsorbingEnds>>,
+    /// Exact ends ([`Track::set_exact_ends`]).
+    pub(super) exact: Option<Box<transparent::ExactEnds>>,
 }
 
 impl Track {
@@ -188,6 +190,7 @@ impl Track {
             unilateral: (params.supports.law == SupportLaw::Tensionless)
                 .then(|| Box::new(Unilateral::new(&params, ns, dt))),
             absorbing: None,
+            exact: None,
         }
     }
 
@@ -309,6 +312,7 @@ impl Track {
             u.ballast_lifted.iter_mut().for_each(|t| *t = CARRIES);
             (u.longest, u.longest_at) = (0.0, 0);
         }
+        self.exact_reset();
     }
 
     /// Node index and shape-function weight for a position: the load at `x` goes
@@ -367,6 +371,9 @@ impl Track {
         if self.absorbing.is_some() {
             self.absorbing_save();
         }
+        if self.exact.is_some() {
+            self.exact_save();
+        }
         match self.simd {
             // No hardware FMA assumed at the baseline (the library `fma` is slow).
             SimdLevel::Baseline => step_body::<false>(self, loads),
@@ -377,6 +384,9 @@ impl Track {
         }
         if self.absorbing.is_some() {
             self.absorbing_apply();
+        }
+        if self.exact.is_some() {
+            self.exact_apply();
         }
     }
 }
@@ -403,6 +413,11 @@ impl Track {
     /// switch; used when a communication step is not a multiple of the step.
     pub fn change_dt(&mut self, dt: f64) -> Result<()> {
         positive("solver.dt", dt, "s")?;
+        if self.exact.is_some() {
+            return Err(Error::Unsupported(
+                "a change of step with exact ends (their kernels are the step's)".into(),
+            ));
+        }
         if dt > self.dt_critical {
             return Err(Error::UnstableTimeStep {
                 dt,

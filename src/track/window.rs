@@ -31,6 +31,13 @@ impl Track {
                 "a moving window on a track with pinned ends".into(),
             ));
         }
+        if self.exact.is_some() && m > 1 {
+            // Exact ends take the exterior's state one span at a time.
+            for _ in 0..m {
+                self.shift_spans(1)?;
+            }
+            return Ok(());
+        }
         let n = self.params.nodes_per_span;
         let sp = self.sp;
         // Phase block p holds nodes k = i n + p, i = 0..count(p), of each rail at
@@ -80,6 +87,10 @@ impl Track {
             let p = self.params;
             u.set_limits(&p);
             u.longest_at -= m as i64;
+        }
+        if self.exact.is_some() {
+            self.exact_shift_one();
+            return Ok(());
         }
         // The window's ends are fixed.
         for (end, _) in self.ends_inner {
