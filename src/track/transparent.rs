@@ -192,6 +192,34 @@ impl Track {
         Ok(())
     }
 
+    /// The exact ends' kernel `h[m]` (m = 0..=M, `h[0] = 0`; `h[m][o][c]`: channel `o`
+    /// of the end node, `(Z, theta)` of the left rail then the right, per unit of the
+    /// last inner node's channel `c` `m` steps before; the right end's, the left end's
+    /// being its mirror image); `None` without exact ends.
+    pub fn exact_end_kernel(&self) -> Option<&[[[f64; 4]; 4]]> {
+        self.exact.as_ref().map(|e| &e.g[0][..])
+    }
+
+    /// Replaces the kernel of [`Track::exact_end_kernel`] by `h` (as many lags): for
+    /// studies of approximations of it. The span entering ahead keeps the exact
+    /// kernels.
+    ///
+    /// Errors: no exact ends, or `h` of another length or with a value not finite.
+    pub fn set_exact_end_kernel(&mut self, h: &[[[f64; 4]; 4]]) -> Result<()> {
+        let Some(e) = &mut self.exact else {
+            return Err(Error::Unsupported("a kernel without exact ends".into()));
+        };
+        if h.len() != e.g[0].len() || h.iter().flatten().flatten().any(|x| !x.is_finite()) {
+            return Err(out_of_range(
+                "exact end kernel length",
+                h.len() as f64,
+                format!("{} lags of finite values", e.g[0].len()),
+            ));
+        }
+        e.g[0] = h.to_vec();
+        Ok(())
+    }
+
     /// The memory (steps) of the exact ends; `None` without them.
     pub fn exact_ends(&self) -> Option<usize> {
         self.exact.as_ref().map(|e| e.mem)
