@@ -151,7 +151,7 @@ fn the_default_window_is_closer_to_a_long_track_than_the_fixed_track_it_replaces
 /// 4 m a side window whose ends remember the whole run equals the 600-span fixed track
 /// through the impact (at 0.04 s) and its waves' return from the plain window's ends;
 /// the same window with fixed ends is off by a tenth of the static load. Measured:
-/// 0.017 % and 11 % of the static load; what remains is the static start's (the
+/// 0.010 % and 9.2 % of the static load; what remains is the static start's (the
 /// kernels' sum over the memory is the exterior's static stiffness to about that, so
 /// the ends settle by a few newtons' worth from the first step).
 #[test]
@@ -395,6 +395,33 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
         other => panic!("{other:?}"),
     }
     s.set_nodes_per_span(8);
+    // Exact ends (breaker, issue 29): a memory shorter than a step was taken as none,
+    // and a layer, voided sleepers or tensionless supports went with them silently.
+    let exact = |m: f64| {
+        Some(TrackWindow {
+            exact_memory: m,
+            ..TrackWindow::DEFAULT
+        })
+    };
+    for m in [1e-7, -0.01, 1.5, f64::NAN] {
+        s.window = exact(m);
+        assert_eq!(name(&s), "track.window.exact_memory", "{m}");
+    }
+    s.window = Some(TrackWindow {
+        layer: 1.0,
+        layer_rate: 300.0,
+        exact_memory: 0.01,
+        ..TrackWindow::DEFAULT
+    });
+    assert_eq!(name(&s), "track.window.exact_memory");
+    s.window = exact(0.01);
+    s.voids = Some(wheelflat::sim::VoidedSleepers {
+        position: 6.85,
+        sleepers: 3,
+        gap: 5e-4,
+    });
+    assert_eq!(name(&s), "track.window.exact_memory");
+    s.voids = None;
     // A moving window needs the fixed rail ends: refused when built, not mid-run.
     s.window = Some(TrackWindow::DEFAULT);
     if let wheelflat::sim::TrackSpec::Discrete(p) = &mut s.track {

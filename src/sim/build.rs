@@ -175,6 +175,46 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
     })
 }
 
+/// The exact ends' memory in steps of `dt` (s) ([`TrackWindow::exact_memory`]), 0 for
+/// none.
+///
+/// Errors: a memory shorter than a step or longer than
+/// [`crate::track::MAX_EXACT_MEMORY`] steps; exact ends with an absorbing layer, voided
+/// sleepers or supports that can lift (the track beyond the window must be the linear
+/// track of the thesis).
+fn exact_memory_steps(w: &TrackWindow, s: &Scenario, p: &TrackParams, dt: f64) -> Result<usize> {
+    let m = w.exact_memory;
+    if m == 0.0 {
+        return Ok(0);
+    }
+    let name = "track.window.exact_memory";
+    let longest = (MAX_EXACT_MEMORY_S).min(crate::track::MAX_EXACT_MEMORY as f64 * dt);
+    if !(m >= dt && m <= longest) {
+        return Err(out_of_range(
+            name,
+            m,
+            format!(
+                "0 (fixed ends), or one step ({} s) to {} s",
+                num(dt),
+                num(longest)
+            ),
+        ));
+    }
+    let why = if w.layer > 0.0 {
+        Some("an absorbing layer (track.window.layer > 0)")
+    } else if s.voids.is_some() {
+        Some("voided sleepers (the track beyond the window must be linear)")
+    } else if p.supports.law == crate::track::SupportLaw::Tensionless {
+        Some("supports that can lift (the track beyond the window must be linear)")
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        return Err(out_of_range(name, m, format!("0 with {why}")));
+    }
+    Ok((m / dt).round() as usize)
+}
+
 /// Longest window side (m) ([`TrackWindow`]).
 pub const MAX_WINDOW_SIDE: f64 = 1000.0;
 
@@ -283,7 +323,7 @@ impl Simulation {
                 if let Some(w) = &window {
                     // Checks the rate too, with or without a layer.
                     t.set_absorbing_ends(w.spec.layer, w.spec.layer_rate)?;
-                    t.set_exact_ends((w.spec.exact_memory / dt).round() as usize)?;
+                    t.set_exact_ends(exact_memory_steps(&w.spec, s, p, dt)?)?;
                 }
                 TrackState::Discrete(t)
             }

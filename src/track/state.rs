@@ -5,13 +5,17 @@ use super::*;
 impl Track {
     /// Number of values in [`Track::state_vector`].
     pub fn state_len(&self) -> usize {
-        1 + 8 * self.nk + 6 * self.ns + self.unilateral.as_ref().map_or(0, |_| 4 * self.ns + 2)
+        1 + 8 * self.nk
+            + 6 * self.ns
+            + self.unilateral.as_ref().map_or(0, |_| 4 * self.ns + 2)
+            + self.exact.as_ref().map_or(0, |e| e.history_len())
     }
 
     /// Everything that determines the continuation: the step, rails (node order, both
     /// rails end to end) and sleepers at t_j and t_(j-1), and the last pad forces;
     /// with supports that can lift, how long each has been lifted and the longest
-    /// lift with its sleeper.
+    /// lift with its sleeper; with exact ends ([`Track::set_exact_ends`]), their drive
+    /// histories and pending response.
     /// [`Track::set_state_vector`] restores it exactly.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = Vec::with_capacity(self.state_len());
@@ -29,6 +33,9 @@ impl Track {
             v.extend_from_slice(&u.pad_lifted);
             v.extend_from_slice(&u.ballast_lifted);
             v.extend([u.longest, u.longest_at as f64]);
+        }
+        if let Some(e) = &self.exact {
+            e.write_history(&mut v);
         }
         v
     }
@@ -70,6 +77,11 @@ impl Track {
             let (head, tail) = rest.split_at(ns);
             a.copy_from_slice(head);
             rest = tail;
+        }
+        if let Some(e) = &mut self.exact {
+            let (head, tail) = rest.split_at(rest.len() - e.history_len());
+            e.read_history(tail)?;
+            rest = head;
         }
         if let Some(u) = &mut self.unilateral {
             let (times, longest) = rest.split_at(4 * ns);

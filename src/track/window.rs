@@ -38,6 +38,9 @@ impl Track {
             }
             return Ok(());
         }
+        if self.exact.is_some() {
+            self.exact_shift_back();
+        }
         let n = self.params.nodes_per_span;
         let sp = self.sp;
         // Phase block p holds nodes k = i n + p, i = 0..count(p), of each rail at
