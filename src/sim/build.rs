@@ -178,7 +178,7 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
 /// The exact ends' memory in steps of `dt` (s) ([`TrackWindow::exact_memory`]), 0 for
 /// none.
 ///
-/// Errors: a memory shorter than a step or longer than
+/// Errors: a memory shorter than [`crate::track::MIN_EXACT_MEMORY`] steps or longer than
 /// [`crate::track::MAX_EXACT_MEMORY`] steps; exact ends with an absorbing layer, voided
 /// sleepers or supports that can lift (the track beyond the window must be the linear
 /// track of the thesis).
@@ -189,13 +189,15 @@ fn exact_memory_steps(w: &TrackWindow, s: &Scenario, p: &TrackParams, dt: f64) -
     }
     let name = "track.window.exact_memory";
     let longest = (MAX_EXACT_MEMORY_S).min(crate::track::MAX_EXACT_MEMORY as f64 * dt);
-    if !(m >= dt && m <= longest) {
+    let shortest = crate::track::MIN_EXACT_MEMORY as f64 * dt;
+    if !(m >= shortest && m <= longest) {
         return Err(out_of_range(
             name,
             m,
             format!(
-                "0 (fixed ends), or one step ({} s) to {} s",
-                num(dt),
+                "0 (fixed ends), or {} steps ({} s) to {} s",
+                crate::track::MIN_EXACT_MEMORY,
+                num(shortest),
                 num(longest)
             ),
         ));

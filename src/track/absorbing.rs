@@ -58,6 +58,13 @@ impl Track {
             ));
         }
         crate::error::non_negative("track.window.layer_rate", rate, "1/s")?;
+        if length > 0.0 && self.exact.is_some() {
+            return Err(out_of_range(
+                "track.window.layer",
+                length,
+                "0 with exact ends (track.window.exact_memory > 0)".to_string(),
+            ));
+        }
         if length == 0.0 {
             self.absorbing = None;
             return Ok(());

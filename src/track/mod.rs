@@ -43,7 +43,7 @@ pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
 pub use stepper::{PointLoad, Track};
 pub use supports::{MAX_VOID_GAP, SupportLaw, Supports};
-pub use transparent::MAX_EXACT_MEMORY;
+pub use transparent::{MAX_EXACT_MEMORY, MIN_EXACT_MEMORY};
 
 // What the files of the track share (each begins with `use super::*`).
 use crate::error::{Error, Result, out_of_range, positive};

@@ -50,6 +50,9 @@ impl Track {
                 format!("{} values for this grid", self.state_len()),
             ));
         }
+        if let Some(e) = &self.exact {
+            e.check_history(&v[v.len() - e.history_len()..])?;
+        }
         if v[0] != self.dt {
             self.change_dt(v[0])?;
         }
@@ -80,7 +83,7 @@ impl Track {
         }
         if let Some(e) = &mut self.exact {
             let (head, tail) = rest.split_at(rest.len() - e.history_len());
-            e.read_history(tail)?;
+            e.read_history(tail);
             rest = head;
         }
         if let Some(u) = &mut self.unilateral {

@@ -410,6 +410,13 @@ impl Track {
     /// Errors: a gap below 0, above 0.05 m or not finite (named `track.void.gap`), or
     /// the wrong count.
     pub fn set_sleeper_gaps(&mut self, gaps: &[Option<f64>]) -> Result<()> {
+        if self.exact.is_some() && gaps.iter().any(Option::is_some) {
+            return Err(Error::Unsupported(
+                "hanging sleepers (track.void.*) with exact ends: the track beyond the ends \
+                 must be linear"
+                    .into(),
+            ));
+        }
         if gaps.len() != self.ns {
             return Err(out_of_range(
                 "sleeper gaps",
