@@ -149,40 +149,14 @@ mod spectrum;
 #[cfg(test)]
 mod tests {
     use super::spectrum;
-    use super::*;
-    use crate::sim::{Scenario, Simulation, TrackSpec};
-    use std::f64::consts::PI;
+    use crate::track::transparent::tests::{pulse_response, track};
 
     /// Rail deflection under a 0.1 ms raised-cosine pulse on both rails at mid-span of
     /// span `j` of `spans` spans, with layers of `ell` m at rate `eta` (1/s).
     fn response(spans: usize, j: usize, ell: f64, eta: f64, n: usize) -> (Vec<f64>, f64) {
-        let dt = Simulation::new(&Scenario::table_4_4()).unwrap().dt();
-        let mut s = Scenario::table_4_4();
-        s.set_spans(spans);
-        let TrackSpec::Discrete(p) = s.track else {
-            unreachable!()
-        };
-        let x = (j as f64 + 0.5) * p.sleeper_spacing;
-        let mut t = Track::new(p, dt).unwrap();
+        let mut t = track(spans);
         t.set_absorbing_ends(ell, eta).unwrap();
-        let u = (0..n)
-            .map(|k| {
-                let tk = k as f64 * dt;
-                let force = if tk < 1e-4 {
-                    50e3 * (1.0 - (2.0 * PI * tk / 1e-4).cos())
-                } else {
-                    0.0
-                };
-                let loads = [0, 1].map(|rail| PointLoad {
-                    rail,
-                    position: x,
-                    force,
-                });
-                t.step(&loads);
-                t.rail_z_at(0, x)
-            })
-            .collect();
-        (u, dt)
+        (pulse_response(&mut t, j, n), t.dt())
     }
 
     /// Energy of `e` (under a Hann window) between `f0` and `f1` (Hz).

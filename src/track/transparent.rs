@@ -543,7 +543,7 @@ impl Track {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::sim::{Scenario, Simulation, TrackSpec};
     use std::f64::consts::PI;
@@ -551,32 +551,9 @@ mod tests {
     /// Rail deflection under a 0.1 ms raised-cosine pulse on both rails at mid-span of
     /// span `j` of `spans` spans over `n` steps, with exact ends of memory `memory`.
     fn response(spans: usize, j: usize, memory: usize, n: usize) -> Vec<f64> {
-        let dt = Simulation::new(&Scenario::table_4_4()).unwrap().dt();
-        let mut s = Scenario::table_4_4();
-        s.set_spans(spans);
-        let TrackSpec::Discrete(p) = s.track else {
-            unreachable!()
-        };
-        let x = (j as f64 + 0.5) * p.sleeper_spacing;
-        let mut t = Track::new(p, dt).unwrap();
+        let mut t = track(spans);
         t.set_exact_ends(memory).unwrap();
-        (0..n)
-            .map(|k| {
-                let tk = k as f64 * dt;
-                let force = if tk < 1e-4 {
-                    50e3 * (1.0 - (2.0 * PI * tk / 1e-4).cos())
-                } else {
-                    0.0
-                };
-                let loads = [0, 1].map(|rail| PointLoad {
-                    rail,
-                    position: x,
-                    force,
-                });
-                t.step(&loads);
-                t.rail_z_at(0, x)
-            })
-            .collect()
+        pulse_response(&mut t, j, n)
     }
 
     #[test]
@@ -604,7 +581,7 @@ mod tests {
     }
 
     /// The table 4.4 track of `spans` spans at the converged default step.
-    fn track(spans: usize) -> Track {
+    pub(in crate::track) fn track(spans: usize) -> Track {
         let dt = Simulation::new(&Scenario::table_4_4()).unwrap().dt();
         let mut s = Scenario::table_4_4();
         s.set_spans(spans);
@@ -612,6 +589,18 @@ mod tests {
             unreachable!()
         };
         Track::new(p, dt).unwrap()
+    }
+
+    /// Rail deflection under a 0.1 ms raised-cosine pulse on both rails at mid-span of
+    /// span `j` of track `t`, over `n` steps.
+    pub(in crate::track) fn pulse_response(t: &mut Track, j: usize, n: usize) -> Vec<f64> {
+        let (x, dt) = ((j as f64 + 0.5) * t.params().sleeper_spacing, t.dt());
+        (0..n)
+            .map(|k| {
+                t.step(&pulse(x, k, dt));
+                t.rail_z_at(0, x)
+            })
+            .collect()
     }
 
     /// A 0.1 ms pulse on both rails at line position `x` (m) at step `k`.
