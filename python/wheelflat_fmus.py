@@ -37,7 +37,8 @@ def install_venv():
     stamp = os.path.join(VENV, ".requirements")
     wanted = open(REQUIREMENTS).read()
     if not (os.path.exists(stamp) and open(stamp).read() == wanted):
-        print("setting up .venv (fmpy, numpy, matplotlib, pytest) ...", file=sys.stderr)
+        print("setting up .venv (python/requirements.txt: fmpy, numpy, matplotlib, pytest, dask, "
+              "libcosimpy, ecospy, libclang, ...) ...", file=sys.stderr)
         if not os.path.exists(venv_python()):
             venv.create(VENV, with_pip=True)
         subprocess.check_call([venv_python(), "-m", "pip", "install", "-q", "-r", REQUIREMENTS])

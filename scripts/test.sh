@@ -9,7 +9,9 @@ cargo fmt --check
 cargo clippy --all-targets -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 cargo build --release
-cargo test --release
+# The examples are not built here: clippy above checks them, and the guide's commands
+# that run one (tests/test_docs.py) build it.
+cargo test --release --lib --bins --tests
 
 echo "   (${SECONDS} s so far)"
 echo "== FMUs: pack fmu/*.fmu and the C header, the library against the glibc 2.28 baseline"
@@ -27,16 +29,28 @@ if ! ldconfig -p | grep libtbb.so.12 >/dev/null; then
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq libtbb12
 fi
 python3 python/wheelflat_fmus.py
-# test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem;
+# test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem.
+# The FMU, study and master tests on two workers (pytest-xdist), one a core; then
+# test_docs.py alone (the guide's scripts it runs pack fmu/ again, which the others
+# read), while the independent importer's test (the fmi crate) builds on one core.
+.venv/bin/python -m pytest -q -n 2 tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
+echo "   (${SECONDS} s so far)"
+# bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
+# the C compiler's own headers.
+export LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)"
+export BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)"
+fmi_log="$(mktemp)"
+cargo test -j1 --no-run --manifest-path tests/fmi_import/Cargo.toml >"$fmi_log" 2>&1 &
+fmi_build=$!
 # test_docs.py: the commands of README.md and docs/guide/ run (or matched to the test
 # that runs them) and the documentation's links
-.venv/bin/python -m pytest -q tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
+.venv/bin/python -m pytest -q tests/test_docs.py
+fmi_rc=0
+wait "$fmi_build" || fmi_rc=$?
+cat "$fmi_log"
+[ "$fmi_rc" -eq 0 ] || exit "$fmi_rc"
 
 echo "   (${SECONDS} s so far)"
 echo "== Rust: the FMUs through an independent importer (the fmi crate)"
-# bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
-# the C compiler's own headers.
-LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)" \
-BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)" \
-    cargo test --manifest-path tests/fmi_import/Cargo.toml
+cargo test --manifest-path tests/fmi_import/Cargo.toml
 echo "== done in ${SECONDS} s"

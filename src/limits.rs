@@ -40,6 +40,11 @@ const fn r(name: &'static str, min: f64, max: f64, unit: &'static str) -> Range 
     }
 }
 
+/// The endless track's window behind the last wheelset (m); `track.window.ahead` is 0
+/// (the fixed track) or in the same range (`crate::sim` checks both against
+/// `MIN_WINDOW_SIDE` and the sleeper spacing when the simulation is built).
+const WINDOW_BEHIND: Range = r("track.window.behind", 4.0, 1000.0, "m");
+
 /// Physical ranges of the parameters, by name (the FMUs' variable names).
 pub const PARAMETER_RANGES: &[Range] = &[
     r("speed", 0.0, 200.0, "m/s"),
@@ -48,7 +53,7 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("contact.CH", 0.0, 1e13, "N/m^1.5"),
     r("track.sleeper_spacing", 0.1, 3.0, "m"),
     r("track.window.ahead", 0.0, 1000.0, "m"),
-    r("track.window.behind", 4.0, 1000.0, "m"),
+    WINDOW_BEHIND,
     r("track.rail_seat_distance", 0.3, 3.0, "m"),
     r("track.rail.EI", 3e5, 1e9, "N m^2"),
     r("track.rail.kAG", 1e7, 1e11, "N"),
@@ -95,6 +100,19 @@ pub fn range(name: &str) -> Option<&'static Range> {
 /// finite). A name without a range only has to be finite.
 pub fn check(name: &str, value: f64) -> Result<f64> {
     match range(name) {
+        // 0 is the thesis' fixed track; a window side is at least the behind side's least.
+        Some(r) if r.name == "track.window.ahead" && value > 0.0 && value < WINDOW_BEHIND.min => {
+            Err(Error::Parameter {
+                name: name.into(),
+                value,
+                allowed: format!(
+                    "track.window.ahead = 0 m (the thesis' fixed track) or {} m <= \
+                     track.window.ahead <= {} m (the endless track)",
+                    num(WINDOW_BEHIND.min),
+                    num(r.max)
+                ),
+            })
+        }
         Some(r) if !(value >= r.min && value <= r.max) => Err(Error::Parameter {
             name: name.into(),
             value,

@@ -192,3 +192,44 @@ fn hanging_sleepers_under_tensionless_supports_start_at_rest_on_any_window() {
         );
     }
 }
+
+#[test]
+fn hanging_sleepers_that_drop_the_wheel_too_far_are_refused_by_their_gap() {
+    // A hundred sleepers hanging 10 mm above the ballast under the starting wheels: the
+    // rail sags past the 10 mm limit, and the refusal names the gap (breaker, issue 29:
+    // it named track.pad.stiffness, a default the user never set).
+    for window in [Some(TrackWindow::DEFAULT), None] {
+        let mut s = Scenario::table_4_4();
+        s.window = window;
+        if window.is_none() {
+            if let wheelflat::sim::TrackSpec::Discrete(p) = &mut s.track {
+                p.spans = 200;
+            }
+            s.start_position = 30.0;
+        }
+        s.voids = Some(VoidedSleepers {
+            position: if window.is_some() { -30.0 } else { 0.0 },
+            sleepers: 100,
+            gap: 0.01,
+        });
+        match Simulation::new(&s) {
+            Err(wheelflat::Error::Parameter {
+                name,
+                value,
+                allowed,
+            }) => {
+                assert_eq!(name, "track.void.gap", "{allowed}");
+                assert_eq!(value, 0.01);
+                assert!(allowed.contains("track.void.sleepers = 100"), "{allowed}");
+            }
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+        // The same gap away from the wheels starts.
+        s.voids = Some(VoidedSleepers {
+            position: s.start_position + 5.0,
+            sleepers: 3,
+            gap: 0.01,
+        });
+        Simulation::new(&s).unwrap();
+    }
+}

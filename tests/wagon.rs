@@ -378,7 +378,7 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
     assert_eq!(name(&s), "track.window.behind");
     // A window too long for the rail's segments is named by the window (breaker, issue
     // 29: it was blamed on track.spans, which the endless track sets itself); 64 nodes
-    // a span allow 1,561 spans, 1,069.285 m.
+    // a span allow 1,561 spans, 1,069.285 m (named to the millimetre below).
     s.window = Some(TrackWindow {
         ahead: 1000.0,
         behind: 1000.0,
@@ -389,12 +389,43 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
         Err(wheelflat::Error::Parameter { name, allowed, .. }) => {
             assert_eq!(name, "track.window.ahead");
             assert!(
-                allowed.contains("track.window.behind <= 1069.285 m"),
+                allowed.contains("track.window.behind <= 1069.284 m"),
                 "{allowed}"
             );
         }
         other => panic!("{other:?}"),
     }
+    // The longest window it names, to the millimetre below, is accepted and two
+    // millimetres more are not (breaker, issue 29: at 0.1 m spacing the named
+    // 156.10000000000002 m was itself refused when split 78.05 + 78.05 m).
+    if let wheelflat::sim::TrackSpec::Discrete(p) = &mut s.track {
+        p.sleeper_spacing = 0.1;
+    }
+    let dt = s.dt;
+    s.dt = 0.0;
+    let most = match Simulation::new(&s) {
+        Err(wheelflat::Error::Parameter { allowed, .. }) => {
+            let at = allowed.find("<= ").unwrap() + 3;
+            let v = &allowed[at..];
+            v[..v.find(' ').unwrap()].parse::<f64>().unwrap()
+        }
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(most, 156.099);
+    let side = |sum: f64| {
+        Some(TrackWindow {
+            ahead: sum - 20.0,
+            behind: 20.0,
+            ..TrackWindow::DEFAULT
+        })
+    };
+    s.window = side(most);
+    Simulation::new(&s).unwrap();
+    s.window = side(most + 2e-3);
+    assert_eq!(name(&s), "track.window.ahead");
+    s.track = Scenario::table_4_4().track;
+    s.dt = dt;
+    s.window = None;
     s.set_nodes_per_span(8);
     // Exact ends (breaker, issue 29): a memory shorter than a step was taken as none,
     // and a layer, voided sleepers or tensionless supports went with them silently.
@@ -438,5 +469,47 @@ fn bad_wheelset_window_and_speed_values_are_refused_by_name() {
             Err(wheelflat::Error::Parameter { name, .. }) => assert_eq!(name, "speed"),
             other => panic!("{v}: {other:?}"),
         }
+    }
+}
+
+#[test]
+fn the_shortest_exact_memory_accepted_holds_where_shorter_ones_grew() {
+    // The third breaker (issue 29): memories of 64 to 69 steps were accepted and grew
+    // without bound after 0.5 to 1.6 s on a 4 m window; 69 steps is now refused by
+    // name, and the shortest memory accepted (128 steps) holds for 2 s, standing and at
+    // 70 km/h, with the rail under the wheel at its static sag.
+    for speed in [0.0, 70.0 / 3.6] {
+        let mut s = Scenario::table_4_4();
+        s.start_position = 6.85;
+        s.speed = speed;
+        let dt = Simulation::new(&s).unwrap().dt();
+        let window = |steps: f64| {
+            Some(TrackWindow {
+                ahead: 4.0,
+                behind: 4.0,
+                exact_memory: steps * dt,
+                ..TrackWindow::DEFAULT
+            })
+        };
+        s.window = window(69.0);
+        match Simulation::new(&s) {
+            Err(wheelflat::Error::Parameter { name, allowed, .. }) => {
+                assert_eq!(name, "track.window.exact_memory");
+                assert!(allowed.contains("128 steps"), "{allowed}");
+            }
+            other => panic!("{:?}", other.map(|_| ())),
+        }
+        s.window = window(128.0);
+        let mut sim = Simulation::new(&s).unwrap();
+        let (mut low, mut high) = (f64::MAX, f64::MIN);
+        sim.run(2.0, |x| {
+            low = low.min(x.rail_z[0]);
+            high = high.max(x.rail_z[0]);
+        })
+        .unwrap();
+        // Perfect wheels on a smooth track: the rail under the wheel stays at its static
+        // sag (1.4 mm, table 4.4) but for the sleeper passing (tens of micrometres).
+        assert!((-1.6e-3..-1.2e-3).contains(&low), "{speed} m/s: {low} m");
+        assert!(high - low < 1e-4, "{speed} m/s: {low} to {high} m");
     }
 }

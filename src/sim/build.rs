@@ -148,7 +148,17 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
     // track.spans, which it replaces, is not the user's to change here).
     let n = p.nodes_per_span.max(1);
     if spans.saturating_mul(n) > MAX_RAIL_SEGMENTS {
-        let most = (MAX_RAIL_SEGMENTS / n).saturating_sub(1) as f64 * a - d_max - 2.0 * l;
+        // The longest sum that fits, to the millimetre below (rounding must not put the
+        // limit it names, however it is split between ahead and behind, one span over).
+        let fits =
+            |sum: f64| (((sum + 2.0 * l + d_max) / a).ceil() as usize) < MAX_RAIL_SEGMENTS / n;
+        let mut most = (((MAX_RAIL_SEGMENTS / n).saturating_sub(1) as f64 * a - d_max - 2.0 * l)
+            * 1e3)
+            .floor()
+            / 1e3;
+        while most > 0.0 && !fits(most + 1e-6) {
+            most = ((most * 1e3).round() - 1.0) / 1e3;
+        }
         return Err(out_of_range(
             "track.window.ahead",
             spec.ahead,

@@ -183,6 +183,16 @@ impl Simulation {
     fn likely_cause(&self) -> String {
         let dt = self.dt();
         let step = match &self.track {
+            // Exact ends' stability is sampled, not proven (breaker, issue 29: memories
+            // of 64 to 69 steps grew after 0.5 to 1.6 s, named as parameters).
+            TrackState::Discrete(t) if t.exact_ends().is_some() => format!(
+                "the window's exact ends (track.window.exact_memory = {} s, {} steps) \
+                 may have made the scheme grow: their stability is sampled, not proven \
+                 (docs/VALIDATION.md, section 4b); try a longer memory or fixed ends \
+                 (track.window.exact_memory = 0)",
+                num(t.exact_ends().unwrap_or(0) as f64 * dt),
+                t.exact_ends().unwrap_or(0)
+            ),
             TrackState::Discrete(t) => format!(
                 "solver.step = {} s is {:.3} of the critical step {} s, so the explicit \
                  scheme should be stable: check parameters far from a railway",

@@ -217,7 +217,7 @@ pub struct TrackWindow {
     /// The layer's largest damping rate (1/s), at the rail ends.
     pub layer_rate: f64,
     /// Exact window ends with this memory (s) ([`crate::track::Track::set_exact_ends`]);
-    /// 0 (the default): none; at least 64 steps. Measured (issue 29, docs/VALIDATION.md):
+    /// 0 (the default): none; at least 128 steps. Measured (issue 29, docs/VALIDATION.md):
     /// a 4 m a side window with 0.1 s of memory is within 0.39 % of the static load of a
     /// 600-span track over 1 s, where the plain converged 20 m window is within 0.53 %;
     /// but evaluated directly its convolutions cost far more than the track (35 to 50 s

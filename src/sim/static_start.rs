@@ -206,6 +206,31 @@ impl Simulation {
             return Ok(());
         }
         let load = self.static_load[0].max(self.static_load[1]);
+        // Hanging sleepers under a wheel (breaker, issue 29: their gap was blamed on the
+        // pads): named by their gap.
+        let x = self.scenario.start_position;
+        let behind = (self.scenario.trailing.iter()).fold(0.0_f64, |d, t| d.max(t.offset));
+        if let Some(v) = self.scenario.voids.filter(|v| v.gap > 0.0) {
+            let a = p.sleeper_spacing;
+            let (from, to) = (v.position - a, v.position + v.sleepers as f64 * a);
+            if x >= from && x - behind <= to {
+                return Err(out_of_range(
+                    "track.void.gap",
+                    v.gap,
+                    format!(
+                        "a gap under the hanging sleepers (track.void.sleepers = {} from \
+                         track.void.position = {} m, under the wheels at the start) that \
+                         leaves the rail's static deflection under the wheel load {} N \
+                         within {MAX_STATIC_RAIL_DEFLECTION} m (this one: {} m); or the \
+                         wheels started off the voided sleepers",
+                        v.sleepers,
+                        num(v.position),
+                        num(load),
+                        num(sag)
+                    ),
+                ));
+            }
+        }
         let (name, value) = if p.ballast_stiffness / 40e6 < p.pad_stiffness / 140e6 {
             ("track.ballast.stiffness", p.ballast_stiffness)
         } else {

@@ -131,6 +131,10 @@ impl Model for FmuModel {
         check_table(spec.name, value)
     }
 
+    fn check_real(spec: &crate::fmu::vars::VarSpec, value: f64) -> Result<(), Error> {
+        crate::limits::check(spec.name, value).map(|_| ())
+    }
+
     fn build(table: &'static FmuTable, values: &[f64], strings: &[String]) -> Result<Self, Error> {
         let kind = Kind::from_guid(table.guid).ok_or_else(|| {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))

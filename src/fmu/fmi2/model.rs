@@ -67,6 +67,14 @@ pub trait Model: Clone + Sized {
     fn check_string(_spec: &VarSpec, _value: &str) -> Result<(), Error> {
         Ok(())
     }
+    /// Checks the value of the Real parameter `spec` when it is set, beyond the range
+    /// of its variable (which the layer checks first): the earliest call that can know
+    /// it is bad.
+    ///
+    /// Errors: a value the model refuses, named with the variable.
+    fn check_real(_spec: &VarSpec, _value: f64) -> Result<(), Error> {
+        Ok(())
+    }
 
     /// The calculated parameters (fixed by [`Model::build`]), in the order FMU states
     /// store them; [`Model::CALCULATED`] values.

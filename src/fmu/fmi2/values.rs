@@ -219,6 +219,11 @@ impl<M: Model> Instance<M> {
                     ),
                 );
             }
+            if s.causality == Causality::Parameter
+                && let Err(e) = M::check_real(s, x)
+            {
+                return self.refuse(Status::Error, format!("{call}: {e}"));
+            }
         }
         // A set call that changed a parameter rebuilds the model (with every input)
         // before it is next used; otherwise every reference of the call is an input,

@@ -20,7 +20,7 @@ fn parameter_ranges_follow_from_physics_and_match_the_engine() {
             }
         }
     }
-    let cases: [(Kind, u32, f64, &str); 5] = [
+    let cases: [(Kind, u32, f64, &str); 8] = [
         (
             Kind::RollPlaneVehicle,
             vr::VEHICLE_PRIMARY_STIFFNESS,
@@ -50,6 +50,27 @@ fn parameter_ranges_follow_from_physics_and_match_the_engine() {
             vr::VEHICLE_SECONDARY_SPACING,
             5e-324,
             "vehicle.secondary.spacing",
+        ),
+        // Between the fixed track (0) and the shortest window (4 m): refused at once,
+        // as `track.window.behind` is (breaker, issue 29: it waited for
+        // fmi2ExitInitializationMode).
+        (
+            Kind::CoupledSystem,
+            vr::TRACK_WINDOW_AHEAD,
+            2.0,
+            "track.window.ahead",
+        ),
+        (
+            Kind::TrackContact,
+            vr::TRACK_WINDOW_AHEAD,
+            1e-300,
+            "track.window.ahead",
+        ),
+        (
+            Kind::CoupledSystem,
+            vr::TRACK_WINDOW_BEHIND,
+            2.0,
+            "track.window.behind",
         ),
     ];
     for (kind, r, x, name) in cases {
