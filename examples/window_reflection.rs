@@ -143,7 +143,12 @@ fn main() {
     let er = band_energy(&reference, dt);
     print!("fixed end's echo / direct response, per band:");
     for (b, (x, y)) in ef.iter().zip(&er).enumerate() {
-        print!(" {:.0}-{:.0} Hz {:.4};", BANDS[b], BANDS[b + 1], (x / y).sqrt());
+        print!(
+            " {:.0}-{:.0} Hz {:.4};",
+            BANDS[b],
+            BANDS[b + 1],
+            (x / y).sqrt()
+        );
     }
     println!();
     let peak = reference.iter().fold(0.0f64, |m, x| m.max(x.abs()));
