@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packs fmu/*.fmu with the shared library built against glibc 2.28 (RHEL 8, Debian 10's
 # 2.28, Ubuntu 20.04's 2.31 and later load it), by cargo-zigbuild (crates.io) with zig
-# (the PyPI package ziglang, in .venv); then checks with objdump -T that no glibc symbol
+# (the PyPI package ziglang, in target/ziglang); then checks with objdump -T that no glibc symbol
 # version above 2.28 is needed. The normal `cargo build` and `build_fmus` are untouched.
 #   bash scripts/build_fmus_glibc228.sh [OUT_DIR]
 set -euo pipefail
@@ -10,9 +10,10 @@ out="${1:-$(dirname "$0")/../fmu}"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 cd "$(dirname "$0")/.."
-python3 python/wheelflat_fmus.py >/dev/null          # .venv
-.venv/bin/python -m pip install -q "ziglang==0.17.1"
-export PATH="$(.venv/bin/python -c 'import ziglang, os; print(os.path.dirname(ziglang.__file__))'):$HOME/.cargo/bin:$PATH"
+# zig in the build folder (not .venv, which the test command fills meanwhile).
+zig="${CARGO_TARGET_DIR:-target}/ziglang"
+[ -x "$zig/ziglang/zig" ] || python3 -m pip install -q --disable-pip-version-check --target "$zig" "ziglang==0.17.1"
+export PATH="$(cd "$zig/ziglang" && pwd):$HOME/.cargo/bin:$PATH"
 command -v cargo-zigbuild >/dev/null || cargo install --locked -q cargo-zigbuild
 target=x86_64-unknown-linux-gnu
 cargo zigbuild --release --quiet --lib --target "$target.2.28"

@@ -17,8 +17,16 @@ echo "   (${SECONDS} s so far)"
 echo "== FMUs: pack fmu/*.fmu and the C header, the library against the glibc 2.28 baseline"
 "${CARGO_TARGET_DIR:-target}/release/build_fmus" fmu
 # The FMUs the tests below load are the ones users get: built with cargo-zigbuild
-# against glibc 2.28 (objdump -T checked), which sets up .venv first.
+# against glibc 2.28 (objdump -T checked), while .venv (python/requirements.txt) is set
+# up beside it (pip works on one core, the build on both).
+venv_log="$(mktemp)"
+python3 python/wheelflat_fmus.py >"$venv_log" 2>&1 &
+venv_setup=$!
 bash scripts/build_fmus_glibc228.sh fmu
+venv_rc=0
+wait "$venv_setup" || venv_rc=$?
+cat "$venv_log"
+[ "$venv_rc" -eq 0 ] || exit "$venv_rc"
 
 echo "   (${SECONDS} s so far)"
 echo "== Python: .venv with fmpy, libcosimpy and ecospy, then the FMU tests"
@@ -32,7 +40,7 @@ python3 python/wheelflat_fmus.py
 # test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem.
 # The FMU, study and master tests on two workers (pytest-xdist), one a core; then
 # test_docs.py alone (the guide's scripts it runs pack fmu/ again, which the others
-# read), while the independent importer's test (the fmi crate) builds on one core.
+# read), while the independent importer's test (the fmi crate) builds beside it.
 .venv/bin/python -m pytest -q -n 2 tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
 echo "   (${SECONDS} s so far)"
 # bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
@@ -40,7 +48,7 @@ echo "   (${SECONDS} s so far)"
 export LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)"
 export BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)"
 fmi_log="$(mktemp)"
-cargo test -j1 --no-run --manifest-path tests/fmi_import/Cargo.toml >"$fmi_log" 2>&1 &
+cargo test --no-run --manifest-path tests/fmi_import/Cargo.toml >"$fmi_log" 2>&1 &
 fmi_build=$!
 # test_docs.py: the commands of README.md and docs/guide/ run (or matched to the test
 # that runs them) and the documentation's links
