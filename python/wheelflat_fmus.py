@@ -38,7 +38,7 @@ def install_venv():
     wanted = open(REQUIREMENTS).read()
     if not (os.path.exists(stamp) and open(stamp).read() == wanted):
         print("setting up .venv (python/requirements.txt: fmpy, numpy, matplotlib, pytest, dask, "
-              "libcosimpy, ecospy, libclang, ...) ...", file=sys.stderr)
+              "libcosimpy, ecospy, ...) ...", file=sys.stderr)
         if not os.path.exists(venv_python()):
             venv.create(VENV, with_pip=True)
         subprocess.check_call([venv_python(), "-m", "pip", "install", "-q", "-r", REQUIREMENTS])

@@ -12,7 +12,7 @@ out="$(cd "$out" && pwd)"
 cd "$(dirname "$0")/.."
 # zig in the build folder (not .venv, which the test command fills meanwhile).
 zig="${CARGO_TARGET_DIR:-target}/ziglang"
-[ -x "$zig/ziglang/zig" ] || python3 -m pip install -q --disable-pip-version-check --target "$zig" "ziglang==0.17.1"
+[ -x "$zig/ziglang/zig" ] || python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$zig" "ziglang==0.17.1"
 export PATH="$(cd "$zig/ziglang" && pwd):$HOME/.cargo/bin:$PATH"
 command -v cargo-zigbuild >/dev/null || cargo install --locked -q cargo-zigbuild
 target=x86_64-unknown-linux-gnu

@@ -4,6 +4,17 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The independent importer's test (the fmi crate, run last) builds from the start at the
+# lowest priority, on what time the rest leaves. bindgen inside it needs libclang (the
+# PyPI package, into the build folder) and the C compiler's own headers.
+clang="${CARGO_TARGET_DIR:-target}/libclang"
+[ -d "$clang/clang/native" ] || python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$clang" "libclang==18.1.1"
+export LIBCLANG_PATH="$(cd "$clang/clang/native" && pwd)"
+export BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)"
+fmi_log="$(mktemp)"
+nice -n 19 cargo test --no-run --manifest-path tests/fmi_import/Cargo.toml >"$fmi_log" 2>&1 &
+fmi_build=$!
+
 echo "== Rust: format, lints, engine and FMI-layer tests"
 cargo fmt --check
 cargo clippy --all-targets -- -D warnings
@@ -40,15 +51,7 @@ python3 python/wheelflat_fmus.py
 # test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem.
 # The FMU, study and master tests on two workers (pytest-xdist, one a core, each taking
 # the next test when it is free); then test_docs.py alone (the guide's scripts it runs
-# pack fmu/ again, which the others read). The independent importer's test (the fmi
-# crate) builds meanwhile at the lowest priority, on what time the tests leave.
-# bindgen inside the fmi crate needs libclang (from .venv, PyPI package libclang) and
-# the C compiler's own headers.
-export LIBCLANG_PATH="$PWD/.venv/$(cd .venv && ls -d lib/python3*/site-packages/clang/native)"
-export BINDGEN_EXTRA_CLANG_ARGS="-I$(cc -print-file-name=include)"
-fmi_log="$(mktemp)"
-nice -n 19 cargo test --no-run --manifest-path tests/fmi_import/Cargo.toml >"$fmi_log" 2>&1 &
-fmi_build=$!
+# pack fmu/ again, which the others read).
 .venv/bin/python -m pytest -q -n 2 --dist worksteal tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
 echo "   (${SECONDS} s so far)"
 # test_docs.py: the commands of README.md and docs/guide/ run (or matched to the test
