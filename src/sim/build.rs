@@ -143,15 +143,16 @@ fn window_spans(p: &mut TrackParams, spec: TrackWindow, d_max: f64, x0: f64) -> 
     }
     // The absorbing layers lie beyond `ahead` and `behind`.
     let l = spec.layer;
-    let spans = ((spec.ahead + spec.behind + 2.0 * l + d_max) / a).ceil() as usize + 1;
+    // Spans of a window whose two sides add up to `sum` (m).
+    let spans_for = |sum: f64| ((sum + 2.0 * l + d_max) / a).ceil() as usize + 1;
+    let spans = spans_for(spec.ahead + spec.behind);
     // The window's own length, named by its own parameters (the fixed track's
     // track.spans, which it replaces, is not the user's to change here).
     let n = p.nodes_per_span.max(1);
     if spans.saturating_mul(n) > MAX_RAIL_SEGMENTS {
         // The longest sum that fits, to the millimetre below (rounding must not put the
         // limit it names, however it is split between ahead and behind, one span over).
-        let fits =
-            |sum: f64| (((sum + 2.0 * l + d_max) / a).ceil() as usize) < MAX_RAIL_SEGMENTS / n;
+        let fits = |sum: f64| spans_for(sum) <= MAX_RAIL_SEGMENTS / n;
         let mut most = (((MAX_RAIL_SEGMENTS / n).saturating_sub(1) as f64 * a - d_max - 2.0 * l)
             * 1e3)
             .floor()
