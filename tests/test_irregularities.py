@@ -81,7 +81,7 @@ def test_the_dipped_weld_is_the_same_dip_as_a_table(coupled):
 
 
 @pytest.mark.parametrize("name, value, message", [
-    ("rail.left.profile", "0 0; 8 x", "rail.left.profile: line 1, its point 2 after a `;`: `8 x` is not two numbers"),
+    ("rail.left.profile", "0 0; 8 x", "rail.left.profile: line 1, its point 2 after a `;`: 2 fields that are not both numbers"),
     ("rail.left.profile", "0,0;8,0;8.5,-2e-3#dip;9,0;30,0", "a `#` in a table on one line"),
     ("rail.left.profile", "/no/such/table.txt", 'rail.left.profile = "/no/such/table.txt": cannot read'),
     ("rail.right.profile", "0 0; 1 0.02", "rail.right.profile (height)"),

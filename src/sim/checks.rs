@@ -7,6 +7,7 @@
 use super::Scenario;
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
 use crate::limits::MAX_WHEELSETS;
+use crate::track::{FOLLOWABLE, FOLLOWABLE_SOURCE, RailProfile};
 
 /// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
 /// below a step's travel (0.3 mm at 70 km/h), so positions integrate the speed.
@@ -19,8 +20,9 @@ impl Scenario {
     /// several wheelsets whose parameters its model refuses (its wheelbase named
     /// `wheelset[2].offset`, the wagon's bogie distance `wheelset[3].offset`), the wheel
     /// radius, a negative or non-finite speed, a start beyond 1e7 m, a negative step or contact constant, more than
-    /// [`MAX_WHEELSETS`] wheelsets, or wheelsets out of order or closer than a wheel
-    /// diameter.
+    /// [`MAX_WHEELSETS`] wheelsets, wheelsets out of order or closer than a wheel
+    /// diameter, or a measured rail profile or out-of-roundness steeper or sharper than
+    /// the contact can follow ([`crate::track::FOLLOWABLE`]).
     pub fn validate(&self) -> Result<()> {
         let s = self;
         // A bogie's wheelbase and the wagon's bogie distance are the wheelsets' offsets
@@ -81,6 +83,25 @@ impl Scenario {
                 (s.trailing.len() + 1) as f64,
                 format!("1 to {MAX_WHEELSETS} wheelsets"),
             ));
+        }
+        // Measured tables the contact could not follow: the rails' are checked as they
+        // are read; a wheel's needs the radius.
+        for (side, rail) in ["left", "right"].iter().zip(&s.rails) {
+            if let Some(t) = &rail.measured {
+                RailProfile::check_measured(t, &format!("rail.{side}.profile"))?;
+            }
+        }
+        let wheels = std::iter::once(("wheel".to_string(), &s.roundness)).chain(
+            (s.trailing.iter().enumerate())
+                .map(|(k, w)| (format!("wheelset[{}].wheel", k + 2), &w.roundness)),
+        );
+        for (wheel, pair) in wheels {
+            for (side, r) in ["left", "right"].iter().zip(pair) {
+                if let Some(r) = r {
+                    let name = format!("{wheel}.{side}.out_of_roundness");
+                    r.check_followable(s.wheel_radius, FOLLOWABLE, FOLLOWABLE_SOURCE, &name)?;
+                }
+            }
         }
         for (k, w) in s.trailing.iter().enumerate() {
             let name = format!("wheelset[{}].offset", k + 2);

@@ -9,6 +9,27 @@ use std::f64::consts::TAU;
 /// Largest height a measured rail profile or a defect may have either way (m).
 pub const MAX_RAIL_IRREGULARITY: f64 = 0.01;
 
+/// Shortest dipped weld or joint (m): the contact sees the rail at the wheel's point,
+/// so shorter features are the contact patch's business.
+pub const MIN_DEFECT_LENGTH: f64 = 0.1;
+
+/// The steepest slope (rad) and sharpest change of slope (1/m) of the steepest dipped
+/// weld the parameters allow ([`MAX_RAIL_IRREGULARITY`] deep over
+/// [`MIN_DEFECT_LENGTH`]): a cosine of depth `D` over `L` rises at most `pi D / L`
+/// (0.314) and bends at most `2 pi^2 D / L^2` (19.7 1/m). A measured table (rail
+/// profile, wheel out-of-roundness along the tread) is held to the same
+/// ([`Table::check_followable`]), so that the contact follows every table it accepts as
+/// it follows that weld.
+pub const FOLLOWABLE: (f64, f64) = (
+    std::f64::consts::PI * MAX_RAIL_IRREGULARITY / MIN_DEFECT_LENGTH,
+    2.0 * std::f64::consts::PI * std::f64::consts::PI * MAX_RAIL_IRREGULARITY
+        / (MIN_DEFECT_LENGTH * MIN_DEFECT_LENGTH),
+);
+
+/// Where [`FOLLOWABLE`] comes from, for error messages.
+pub const FOLLOWABLE_SOURCE: &str = "the steepest dipped weld allowed, 0.01 m deep over 0.1 m: rail.defect.depth and \
+     rail.defect.length";
+
 /// A dipped weld or joint: the rail head dips by `depth` over `length`, centred at
 /// `position`, in the shape of one cosine wave, `-depth (1 + cos(2 pi (x - x_0) /
 /// length)) / 2` for `|x - x_0| < length / 2`: the usual idealisation of a dipped weld
@@ -27,7 +48,7 @@ impl RailDefect {
     /// Checks the fields; `name` prefixes their names (`rail.defect`).
     pub fn validate(&self, name: &str) -> Result<()> {
         crate::error::finite(&format!("{name}.position"), self.position, "m")?;
-        if !(0.1..=10.0).contains(&self.length) {
+        if !(MIN_DEFECT_LENGTH..=10.0).contains(&self.length) {
             return Err(out_of_range(
                 &format!("{name}.length"),
                 self.length,
@@ -74,8 +95,8 @@ pub struct RailProfile {
 }
 
 impl RailProfile {
-    /// Checks a measured table's heights (at most [`MAX_RAIL_IRREGULARITY`] either way);
-    /// `name` names it in errors.
+    /// Checks a measured table's heights (at most [`MAX_RAIL_IRREGULARITY`] either way)
+    /// and its steepness ([`FOLLOWABLE`]); `name` names it in errors.
     pub fn check_measured(table: &Table, name: &str) -> Result<()> {
         let (_, h) = table.points();
         if let Some(&bad) = h.iter().find(|h| h.abs() > MAX_RAIL_IRREGULARITY) {
@@ -85,7 +106,13 @@ impl RailProfile {
                 format!("-{MAX_RAIL_IRREGULARITY} m <= height <= {MAX_RAIL_IRREGULARITY} m"),
             ));
         }
-        Ok(())
+        table.check_followable(
+            &format!("{name} (height against position)"),
+            1.0,
+            None,
+            FOLLOWABLE,
+            FOLLOWABLE_SOURCE,
+        )
     }
 
     /// Whether the rail has any irregularity.

@@ -37,7 +37,10 @@ mod transparent;
 mod window;
 
 pub use crate::numerics::SimdLevel;
-pub use irregularity::{MAX_RAIL_IRREGULARITY, RailDefect, RailProfile};
+pub use irregularity::{
+    FOLLOWABLE, FOLLOWABLE_SOURCE, MAX_RAIL_IRREGULARITY, MIN_DEFECT_LENGTH, RailDefect,
+    RailProfile,
+};
 pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;

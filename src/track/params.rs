@@ -232,32 +232,32 @@ impl TrackParams {
         // An instance's build, its resets and a study's cases ask for the same bound
         // again and again, and the scan below costs about 250 us (a tenth of the FMI
         // fuzz test's time): the last few are kept, per thread, by their exact inputs.
+        // Everything kept is `Copy`: a thread-local that needs dropping registers a
+        // destructor with the C library, which pins a loaded FMU's library until the
+        // thread exits (dlclose then leaves it mapped; issue 38, N4).
         const KEPT: usize = 4;
-        type Bound = (TrackParams, u64, (f64, String));
+        type Kept = [Option<(TrackParams, u64, StabilityBound)>; KEPT];
         thread_local! {
-            static LAST: std::cell::RefCell<Vec<Bound>> = const { std::cell::RefCell::new(Vec::new()) };
+            static LAST: std::cell::Cell<Kept> = const { std::cell::Cell::new([None; KEPT]) };
         }
         let key = kc.to_bits();
-        if let Some(b) = LAST.with_borrow(|l| {
-            (l.iter())
-                .find(|(p, k, _)| p == self && *k == key)
-                .map(|(_, _, b)| b.clone())
-        }) {
-            return b;
-        }
-        let b = self.stability_scan(kc);
-        LAST.with_borrow_mut(|l| {
-            if l.len() == KEPT {
-                l.remove(0);
+        let mut last = LAST.get();
+        let bound = match (last.iter().flatten()).find(|(p, k, _)| p == self && *k == key) {
+            Some(&(_, _, b)) => b,
+            None => {
+                let b = self.stability_scan(kc);
+                last.rotate_left(1);
+                last[KEPT - 1] = Some((*self, key, b));
+                LAST.set(last);
+                b
             }
-            l.push((*self, key, b.clone()));
-        });
-        b
+        };
+        (bound.dt, bound.describe(self.dx()))
     }
 
     /// [`TrackParams::stability_bound`], computed: the rail's dispersion sampled at
     /// 4,097 wavenumbers, the supports' largest eigenvalue, the pads' damping.
-    fn stability_scan(&self, kc: f64) -> (f64, String) {
+    fn stability_scan(&self, kc: f64) -> StabilityBound {
         let r = &self.rail;
         let dx = self.dx();
         let m = r.mass;
@@ -314,32 +314,71 @@ impl TrackParams {
         let dt_undamped = 2.0 / lam.sqrt();
         let lz = lam_z + lam_sup;
         let dt_damped = (-eta + (eta * eta + 4.0 * lz).sqrt()) / lz;
+        let (dt, limiter) = if dt_damped < dt_undamped {
+            (dt_damped, Limiter::PadDamper)
+        } else {
+            let c = (4.0 * r.ei / (dx * dx) + r.kag) / mr2;
+            let limiter = if c >= lam_z {
+                Limiter::Rotation
+            } else if c >= lam_z - d {
+                // The rotation would set it without the contact.
+                Limiter::DeflectionUnderContact
+            } else {
+                Limiter::Shear
+            };
+            (dt_undamped, limiter)
+        };
+        StabilityBound {
+            dt,
+            limiter,
+            contact_stiffness: kc,
+        }
+    }
+}
+
+/// Which stencil sets the track's stability bound ([`TrackParams::critical_time_step`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Limiter {
+    /// The explicit rail-pad damper on the deflection stencil.
+    PadDamper,
+    /// The rail rotation (bending) stencil.
+    Rotation,
+    /// The deflection stencil, raised above the rotation by the contact spring.
+    DeflectionUnderContact,
+    /// The rail shear (deflection) stencil.
+    Shear,
+}
+
+/// A stability bound as computed: the step (s), what sets it and the contact stiffness
+/// (N/m) it was computed with; plain data, so that the thread's cache needs no drop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct StabilityBound {
+    dt: f64,
+    limiter: Limiter,
+    contact_stiffness: f64,
+}
+
+impl StabilityBound {
+    /// The text naming what sets the bound, at node spacing `dx` (m).
+    fn describe(&self, dx: f64) -> String {
+        let kc = self.contact_stiffness;
         let with_contact = if kc > 0.0 {
             format!(" and the contact stiffness {kc:.2e} N/m under the wheel")
         } else {
             String::new()
         };
-        if dt_damped < dt_undamped {
-            (
-                dt_damped,
-                format!(
+        let what = match self.limiter {
+            Limiter::PadDamper => {
+                return format!(
                     "the explicit rail-pad damper on the rail deflection stencil (dx = {dx:.4} m){with_contact}"
-                ),
-            )
-        } else {
-            let c = (4.0 * r.ei / (dx * dx) + r.kag) / mr2;
-            let what = if c >= lam_z {
-                "the rail rotation (bending) stencil"
-            } else if c >= lam_z - d {
-                // The rotation would set it without the contact.
+                );
+            }
+            Limiter::Rotation => "the rail rotation (bending) stencil",
+            Limiter::DeflectionUnderContact => {
                 "the rail deflection stencil under the contact spring"
-            } else {
-                "the rail shear (deflection) stencil"
-            };
-            (
-                dt_undamped,
-                format!("{what} at dx = {dx:.4} m with pads and sleepers{with_contact}"),
-            )
-        }
+            }
+            Limiter::Shear => "the rail shear (deflection) stencil",
+        };
+        format!("{what} at dx = {dx:.4} m with pads and sleepers{with_contact}")
     }
 }

@@ -50,6 +50,27 @@ impl OutOfRoundness {
         Ok(OutOfRoundness { table })
     }
 
+    /// Checks that the contact can follow the table on a wheel of `radius` (m): the
+    /// deviation against the distance along the tread (`radius` times the angle, once
+    /// round the wheel, the last point joining the first), held to `limits` (slope,
+    /// change of slope per metre; `source` says where they come from,
+    /// [`crate::numerics::Table::check_followable`]). `name` names the table.
+    pub fn check_followable(
+        &self,
+        radius: f64,
+        limits: (f64, f64),
+        source: &str,
+        name: &str,
+    ) -> Result<()> {
+        self.table.check_followable(
+            &format!("{name} (radius deviation along the tread, wheel radius {radius} m)"),
+            radius,
+            Some(TAU),
+            limits,
+            source,
+        )
+    }
+
     /// The wrap-around segment, from the last point to the first a turn later: its
     /// start angle, the deviation there, and its slope; `beta` in `[0, 2 pi)`.
     #[inline]

@@ -292,19 +292,17 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
 /// precision with comments to spare.
 pub const MAX_TABLE_FILE: u64 = 100_000_000;
 
-/// The table a String parameter `name` names in `text`: none for an empty text, the
-/// text itself when it holds a `;` or a line break (`0 0; 0.1 2e-5; ...`), else the
-/// file at that path (absolute, or relative to the working directory of the process
-/// that loaded the FMU), read by [`Table::parse`].
+/// The content of the table a String parameter `name` gives in `text`: empty for an
+/// empty text (no table), the text itself when it holds a `;` or a line break (`0 0;
+/// 0.1 2e-5; ...`), else the text of the file at that path (absolute, or relative to
+/// the working directory of the process that loaded the FMU), read now, once.
 ///
-/// Errors: a file that cannot be read, or text that is not a table, naming `name`.
-pub fn read_table(name: &str, text: &str) -> Result<Option<Table>, Error> {
+/// Errors: a file that cannot be read, is not a regular file or is too large, naming
+/// `name` and the path; nothing of the file is quoted.
+pub fn table_content(name: &str, text: &str) -> Result<Arc<str>, Error> {
     let text = text.trim();
-    if text.is_empty() {
-        return Ok(None);
-    }
-    if text.contains(';') || text.contains('\n') {
-        return Table::parse(text, name).map(Some);
+    if text.is_empty() || text.contains(';') || text.contains('\n') {
+        return Ok(Arc::from(text));
     }
     let refuse = |why: String| {
         Error::Table(format!(
@@ -326,40 +324,65 @@ pub fn read_table(name: &str, text: &str) -> Result<Option<Table>, Error> {
             meta.len()
         )));
     }
-    let content = std::fs::read_to_string(text)
-        .map_err(|e| refuse(format!("cannot read the table's file ({e})")))?;
-    Table::parse(&content, &format!("{name} ({text})")).map(Some)
+    let content = std::fs::read_to_string(text).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::InvalidData => "the file is not UTF-8 text".to_string(),
+            _ => format!("cannot read the table's file ({e})"),
+        };
+        refuse(why)
+    })?;
+    Ok(Arc::from(content))
 }
 
-/// Checks the String parameter `name`'s value `text` as the model will read it: a rail
-/// profile's heights, a wheel's out-of-roundness angles and deviations.
-pub fn check_table(name: &str, text: &str) -> Result<(), Error> {
-    match read_table(name, text)? {
-        None => Ok(()),
-        Some(t) if name.ends_with(".out_of_roundness") => OutOfRoundness::new(t, name).map(|_| ()),
-        Some(t) => RailProfile::check_measured(&t, name),
+/// The table in `content` ([`table_content`]): none when empty, else read by
+/// [`Table::parse`]; `name` names it in errors.
+pub fn parse_table(name: &str, content: &str) -> Result<Option<Table>, Error> {
+    if content.trim().is_empty() {
+        return Ok(None);
     }
+    Table::parse(content, name).map(Some)
 }
 
-/// `s` with the tables the String parameters `strings` (by value reference) name: the
-/// rails' measured profiles and the wheels' out-of-roundness.
-pub fn with_tables(mut s: Scenario, strings: &[String]) -> Result<Scenario, Error> {
+/// Reads the String parameter `name`'s value `text` as the model will ([`table_content`])
+/// and checks the table: a rail profile's heights and steepness, a wheel's
+/// out-of-roundness angles and deviations (its steepness needs the wheel radius: the
+/// scenario's check). Gives the content the model is built from.
+pub fn check_table(name: &str, text: &str) -> Result<Arc<str>, Error> {
+    let content = table_content(name, text)?;
+    let label = if content.as_ref() == text.trim() {
+        name.to_string()
+    } else {
+        format!("{name} (the file {})", text.trim())
+    };
+    match parse_table(&label, &content)? {
+        None => {}
+        Some(t) if name.ends_with(".out_of_roundness") => {
+            OutOfRoundness::new(t, &label)?;
+        }
+        Some(t) => RailProfile::check_measured(&t, &label)?,
+    }
+    Ok(content)
+}
+
+/// `s` with the tables the String parameters' `contents` (by value reference,
+/// [`check_table`]) hold: the rails' measured profiles and the wheels' out-of-roundness.
+pub fn with_tables(mut s: Scenario, contents: &[Arc<str>]) -> Result<Scenario, Error> {
     let text = |name: &str| -> &str {
         crate::fmu::vars::COUPLED_SYSTEM
             .vars
             .iter()
             .find(|v| v.name == name)
-            .map_or("", |v| strings[v.vr as usize].as_str())
+            .map_or("", |v| &contents[v.vr as usize])
     };
     let wheel = |name: String| -> Result<Option<Arc<OutOfRoundness>>, Error> {
-        match read_table(&name, text(&name))? {
+        match parse_table(&name, text(&name))? {
             None => Ok(None),
             Some(t) => Ok(Some(Arc::new(OutOfRoundness::new(t, &name)?))),
         }
     };
     for (side, rail) in ["left", "right"].iter().zip(&mut s.rails) {
         let name = format!("rail.{side}.profile");
-        if let Some(t) = read_table(&name, text(&name))? {
+        if let Some(t) = parse_table(&name, text(&name))? {
             RailProfile::check_measured(&t, &name)?;
             rail.measured = Some(Arc::new(t));
         }

@@ -13,6 +13,7 @@ use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
 use crate::fmu::vars::{FmuTable, TRAILING, VarSpec, enums, vr};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
 use crate::sim::{Sample, Simulation, TrackSpec, VehicleState, VehicleUnit};
+use std::sync::Arc;
 
 /// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
 /// end's reflections raise the forces (the default start position, 1.37 m, is two
@@ -127,7 +128,7 @@ impl FmuModel {
 impl Model for FmuModel {
     const CALCULATED: usize = Published::LEN;
 
-    fn check_string(spec: &crate::fmu::vars::VarSpec, value: &str) -> Result<(), Error> {
+    fn read_string(spec: &crate::fmu::vars::VarSpec, value: &str) -> Result<Arc<str>, Error> {
         check_table(spec.name, value)
     }
 
@@ -135,7 +136,11 @@ impl Model for FmuModel {
         crate::limits::check(spec.name, value).map(|_| ())
     }
 
-    fn build(table: &'static FmuTable, values: &[f64], strings: &[String]) -> Result<Self, Error> {
+    fn build(
+        table: &'static FmuTable,
+        values: &[f64],
+        contents: &[Arc<str>],
+    ) -> Result<Self, Error> {
         let kind = Kind::from_guid(table.guid).ok_or_else(|| {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
         })?;
@@ -154,7 +159,7 @@ impl Model for FmuModel {
                 (Engine::Vehicle(Box::new(u)), published)
             }
             Kind::TrackContact | Kind::CoupledSystem => {
-                let sim = Simulation::new(&with_tables(scenario(kind, values), strings)?)?;
+                let sim = Simulation::new(&with_tables(scenario(kind, values), contents)?)?;
                 let mut trailing_static_wheel_z = [[0.0; 2]; TRAILING];
                 for (z, k) in trailing_static_wheel_z.iter_mut().zip(1..) {
                     if let Some(s) = sim.sample_of(k) {

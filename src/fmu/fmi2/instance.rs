@@ -7,6 +7,7 @@ use super::model::{Model, StepFault};
 use super::status::{FmiResult, LOG_CATEGORIES, Logger, Refusal, Status};
 use crate::error::Error;
 use crate::fmu::vars::{FmuTable, N_VR};
+use std::sync::Arc;
 
 /// One FMU instance of the model `M`.
 pub struct Instance<M: Model> {
@@ -19,6 +20,9 @@ pub struct Instance<M: Model> {
     /// Current values of the String parameters, by value reference (empty for every
     /// other reference).
     pub(super) strings: Vec<String>,
+    /// Their contents, as [`Model::read_string`] read them when they were set (a table
+    /// file's text for its path): what the model is built from.
+    pub(super) contents: Vec<Arc<str>>,
     /// The C strings of the last `fmi2GetString`, alive until the next call.
     pub(super) string_buffers: Vec<std::ffi::CString>,
     pub(super) phase: Phase,
@@ -75,6 +79,7 @@ impl<M: Model> Instance<M> {
             slot,
             values,
             strings: vec![String::new(); N_VR],
+            contents: vec![Arc::from(""); N_VR],
             string_buffers: Vec::new(),
             phase: Phase::Instantiated,
             model: None,
@@ -307,12 +312,14 @@ impl<M: Model> Instance<M> {
     /// `fmi2ExitInitializationMode`: builds the model if parameters changed.
     pub fn exit_initialization(&mut self) -> FmiResult {
         self.check(Call::ExitInitializationMode)?;
-        // Inputs set for another configuration than the one now fixed.
+        // Inputs set for another configuration than the one now fixed; written at their
+        // start value they change nothing (issue 38, N7: a master may write every
+        // input's start).
         let misused = self
             .table
             .vars
             .iter()
-            .filter(|v| self.given[v.vr as usize])
+            .filter(|v| self.given[v.vr as usize] && self.values[v.vr as usize] != v.start)
             .find_map(|v| self.unused_input(v));
         if let Some(why) = misused {
             return self.refuse(Status::Error, format!("fmi2ExitInitializationMode: {why}"));
@@ -349,6 +356,7 @@ impl<M: Model> Instance<M> {
             self.values[v.vr as usize] = v.start;
         }
         self.strings.iter_mut().for_each(String::clear);
+        self.contents.iter_mut().for_each(|c| *c = Arc::from(""));
         self.phase = Phase::Instantiated;
         self.model = None;
         self.dirty = true;
@@ -377,7 +385,7 @@ impl<M: Model> Instance<M> {
     pub(super) fn ensure_model(&mut self) -> FmiResult {
         if self.model.is_none() || self.dirty {
             let old = self.model.take();
-            match M::build(self.table, &self.values, &self.strings) {
+            match M::build(self.table, &self.values, &self.contents) {
                 Ok(m) => {
                     self.calculated = m.calculated();
                     self.model = Some(m);
@@ -387,6 +395,13 @@ impl<M: Model> Instance<M> {
                     // where the model put them.
                     let (given, at_rest): (Vec<u32>, Vec<u32>) =
                         self.table.inputs().partition(|&r| self.given[r as usize]);
+                    // An input of the configuration not in use keeps its start.
+                    let at_rest: Vec<u32> = (at_rest.into_iter())
+                        .filter(|&r| {
+                            let i = self.slot[r as usize].expect("an input of the table");
+                            self.unused_input(&self.table.vars[i]).is_none()
+                        })
+                        .collect();
                     if let Some(m) = &self.model {
                         for r in at_rest {
                             if let Some(x) = m.input_at_rest(r) {

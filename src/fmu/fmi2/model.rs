@@ -4,6 +4,7 @@
 
 use crate::error::Error;
 use crate::fmu::vars::{FmuTable, VarSpec};
+use std::sync::Arc;
 
 /// How a failed step leaves the run (FMI 2.0, section 4.2.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,14 +59,23 @@ pub trait Model: Clone + Sized {
     /// its initial state.
     ///
     /// Errors: any parameter the model refuses, named with its value and allowed range.
-    /// `strings[vr]` holds the String parameters' values (empty for the others).
-    fn build(table: &'static FmuTable, values: &[f64], strings: &[String]) -> Result<Self, Error>;
-    /// Checks the value of the String parameter `spec` when it is set: the earliest
-    /// call that can know it is bad.
+    /// `contents[vr]` holds the String parameters' contents as
+    /// [`Model::read_string`] gave them when they were set (empty for the others).
+    fn build(
+        table: &'static FmuTable,
+        values: &[f64],
+        contents: &[Arc<str>],
+    ) -> Result<Self, Error>;
+    /// Reads and checks the value of the String parameter `spec` when it is set (the
+    /// earliest call that can know it is bad): its content, what the model will be
+    /// built from. A value that names a file gives the file's text, read here once:
+    /// the instance keeps the content, FMU states and their serialized form carry it,
+    /// so that nothing built later reads the file again (issue 38). The default: the
+    /// value itself.
     ///
     /// Errors: a value the model refuses, named with the variable.
-    fn check_string(_spec: &VarSpec, _value: &str) -> Result<(), Error> {
-        Ok(())
+    fn read_string(_spec: &VarSpec, value: &str) -> Result<Arc<str>, Error> {
+        Ok(Arc::from(value))
     }
     /// Checks the value of the Real parameter `spec` when it is set, beyond the range
     /// of its variable (which the layer checks first): the earliest call that can know

@@ -1,12 +1,19 @@
 //! FMU states (FMI 2.0, section 2.1.8): saved, restored, serialized and deserialized.
 //! A serialized state holds the parameters, so it restores into a fresh instance: the
-//! model is rebuilt from them and its dynamic state put back.
+//! model is rebuilt from them and its dynamic state put back. A String parameter is
+//! held with its content (a table file's text, as read when it was set): a state
+//! restored or deserialized anywhere, after its file changed or where no file is,
+//! continues the run it was taken from. The content is carried, not its hash, so that
+//! a state moves to another process or machine (a cluster's worker) and restores there
+//! without the file; tables are small next to the track's state (a 1,000-point profile
+//! is about 20 kB).
 
 use super::calls::{Call, Phase};
 use super::instance::Instance;
 use super::model::Model;
 use super::status::{FmiResult, Status};
 use crate::fmu::vars::{Causality, FmuTable, N_VR, VarType};
+use std::sync::Arc;
 
 /// Everything an FMU state holds: enough to continue bit-identically.
 #[derive(Debug, Clone)]
@@ -16,6 +23,8 @@ pub struct Snapshot<M> {
     values: Vec<f64>,
     /// The String parameters, by value reference.
     strings: Vec<String>,
+    /// Their contents ([`Model::read_string`]).
+    contents: Vec<Arc<str>>,
     model: Option<M>,
     calculated: Vec<f64>,
     time: f64,
@@ -26,7 +35,7 @@ pub struct Snapshot<M> {
 }
 
 /// The start of every serialized state.
-pub(crate) const MAGIC: &[u8] = b"wheelflat-fmu-state-3\0";
+pub(crate) const MAGIC: &[u8] = b"wheelflat-fmu-state-4\0";
 
 impl<M: Model> Instance<M> {
     /// `fmi2GetFMUstate`.
@@ -38,6 +47,7 @@ impl<M: Model> Instance<M> {
             phase: self.phase,
             values: self.values.clone(),
             strings: self.strings.clone(),
+            contents: self.contents.clone(),
             model: self.model.clone(),
             calculated: self.calculated.clone(),
             time: self.time,
@@ -61,6 +71,7 @@ impl<M: Model> Instance<M> {
         self.phase = s.phase;
         self.values.clone_from(&s.values);
         self.strings.clone_from(&s.strings);
+        self.contents.clone_from(&s.contents);
         self.model.clone_from(&s.model);
         self.dirty = self.model.is_none();
         self.calculated.clone_from(&s.calculated);
@@ -75,7 +86,7 @@ impl<M: Model> Instance<M> {
 
     /// `fmi2SerializeFMUstate`: magic, GUID, phase, clock, reason of a stopped run,
     /// calculated parameters, values, the String parameters that are set (value
-    /// reference, length, UTF-8 bytes), model state.
+    /// reference, length, UTF-8 bytes, then the same of their content), model state.
     pub fn serialize(&mut self, s: &Snapshot<M>) -> FmiResult<Vec<u8>> {
         let model = match s.model.as_ref().map(M::state_vector) {
             None => Vec::new(),
@@ -111,8 +122,10 @@ impl<M: Model> Instance<M> {
         b.extend_from_slice(&(set.len() as u64).to_le_bytes());
         for (r, t) in set {
             b.extend_from_slice(&(r as u64).to_le_bytes());
-            b.extend_from_slice(&(t.len() as u64).to_le_bytes());
-            b.extend_from_slice(t.as_bytes());
+            for t in [t.as_bytes(), s.contents[r].as_bytes()] {
+                b.extend_from_slice(&(t.len() as u64).to_le_bytes());
+                b.extend_from_slice(t);
+            }
         }
         b.extend_from_slice(&(model.len() as u64).to_le_bytes());
         for x in &model {
@@ -219,6 +232,7 @@ impl<M: Model> Instance<M> {
             values.push(r.f64()?);
         }
         let mut strings = vec![String::new(); N_VR];
+        let mut contents: Vec<Arc<str>> = vec![Arc::from(""); N_VR];
         let ns = r.u64()? as usize;
         if ns > N_VR {
             return Err(format!("{ns} String values; this FMU has at most {N_VR}"));
@@ -236,11 +250,13 @@ impl<M: Model> Instance<M> {
                     "stored value reference {vr} is no String parameter"
                 ));
             }
-            let len = r.u64()? as usize;
-            let text = r.take(len)?;
-            strings[vr] = std::str::from_utf8(text)
-                .map_err(|_| format!("stored String value of reference {vr} is not UTF-8"))?
-                .to_string();
+            let mut text = || -> Result<&str, String> {
+                let len = r.u64()? as usize;
+                std::str::from_utf8(r.take(len)?)
+                    .map_err(|_| format!("stored String value of reference {vr} is not UTF-8"))
+            };
+            strings[vr] = text()?.to_string();
+            contents[vr] = Arc::from(text()?);
         }
         let nm = r.u64()? as usize;
         if nm > bytes.len() / 8 {
@@ -267,7 +283,7 @@ impl<M: Model> Instance<M> {
         self.check_stored((time, start_time), &calculated, &values, &state)?;
         let model = if has_model && !stopped {
             // Build with the stored parameters, then overwrite the dynamic state.
-            let mut m = M::build(self.table, &values, &strings)
+            let mut m = M::build(self.table, &values, &contents)
                 .map_err(|e| format!("stored parameters refused: {e}"))?;
             let again = m.calculated();
             if let Some(k) =
@@ -298,6 +314,7 @@ impl<M: Model> Instance<M> {
             phase,
             values,
             strings,
+            contents,
             model,
             calculated,
             time,

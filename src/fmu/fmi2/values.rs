@@ -156,10 +156,35 @@ impl<M: Model> Instance<M> {
         })
     }
 
+    /// Whether `x` written to reference `r` (by `real`: a Real) is an input of the
+    /// configuration not in use at its declared start value, after initialisation: a
+    /// master that writes every input's start (fmpy's `apply_start_values`, an SSP's
+    /// connectors) changes nothing by it, and it is passed over (issue 38, N7).
+    fn unused_at_start(&self, r: u32, x: f64, real: bool) -> bool {
+        let Some(s) = (self.slot.get(r as usize).copied().flatten()).map(|i| &self.table.vars[i])
+        else {
+            return false;
+        };
+        s.causality == Causality::Input
+            && (s.ty == VarType::Real) == real
+            && s.ty != VarType::String
+            && x == s.start
+            && !matches!(self.phase, Phase::Instantiated | Phase::Initialization)
+            && self.unused_input(s).is_some()
+    }
+
     /// Writes variables (Real or Integer/Enumeration by `real`): every value is checked
-    /// before any is stored, so a refused call changes nothing.
+    /// before any is stored, so a refused call changes nothing. An input of the
+    /// configuration not in use, written at its start value, is passed over
+    /// ([`Instance::unused_at_start`]).
     fn set(&mut self, call: Call, vrs: &[u32], vals: &[f64], real: bool) -> FmiResult {
         self.check(call)?;
+        if (vrs.iter().zip(vals)).any(|(&r, &x)| self.unused_at_start(r, x, real)) {
+            let (vrs, vals): (Vec<u32>, Vec<f64>) = (vrs.iter().zip(vals))
+                .filter(|&(&r, &x)| !self.unused_at_start(r, x, real))
+                .unzip();
+            return self.set(call, &vrs, &vals, real);
+        }
         let call = call.name();
         let (mut inputs, mut parameters) = (false, false);
         for (&r, &x) in vrs.iter().zip(vals) {
@@ -297,12 +322,14 @@ impl<M: Model> Instance<M> {
     /// Boolean and String access for an FMU without such variables: any value
     /// reference is unknown (an empty request succeeds).
     /// `fmi2SetString`: String parameters, in the phases parameters are set; each
-    /// value checked by the model ([`Model::check_string`]) before any is stored.
+    /// value read and checked by the model ([`Model::read_string`]) before any is
+    /// stored; the instance keeps what was set and its content (a file's text, read
+    /// once here: setting the same path again reads the file again).
     pub fn set_string(&mut self, vrs: &[u32], vals: &[String]) -> FmiResult {
         let call = Call::SetString;
         self.check(call)?;
         let name = call.name();
-        for (&r, v) in vrs.iter().zip(vals) {
+        for &r in vrs {
             let s = self.string_spec(name, r)?;
             if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
                 return self.refuse(
@@ -314,19 +341,25 @@ impl<M: Model> Instance<M> {
                     ),
                 );
             }
-            if let Err(e) = M::check_string(s, v) {
-                return self.refuse(Status::Error, format!("{name}: {e}"));
+        }
+        let mut contents = Vec::with_capacity(vrs.len());
+        for (&r, v) in vrs.iter().zip(vals) {
+            let s = self.string_spec(name, r)?;
+            match M::read_string(s, v) {
+                Ok(c) => contents.push(c),
+                Err(e) => return self.refuse(Status::Error, format!("{name}: {e}")),
             }
         }
-        for (&r, v) in vrs.iter().zip(vals) {
+        for ((&r, v), c) in vrs.iter().zip(vals).zip(contents) {
             self.log_call(|| {
                 format!(
                     "{name}(vr={r}, value={:?})",
                     v.chars().take(200).collect::<String>()
                 )
             });
-            if self.strings[r as usize] != *v {
+            if self.strings[r as usize] != *v || self.contents[r as usize] != c {
                 self.strings[r as usize] = v.clone();
+                self.contents[r as usize] = c;
                 self.dirty = true;
             }
         }

@@ -7,7 +7,7 @@ mod clock;
 mod machine;
 
 pub(super) use crate::fmu::fmi2::{ALL, MAGIC};
-pub(super) use crate::fmu::vars::{self, Causality, vr};
+pub(super) use crate::fmu::vars::{self, Causality, VarType, vr};
 pub(super) use crate::fmu::*;
 pub(super) use crate::sim::Simulation;
 pub(super) use crate::sim::{Scenario, VehicleSpec};
