@@ -348,3 +348,62 @@ def _interp(t, ts, xs):
 
 if __name__ == "__main__":
     worker(json.loads(sys.argv[1]))
+
+
+def test_the_shipped_contact_pair_runs_in_fmpy_simulate_ssp(capfd):
+    """(f) fmpy's own SSP master (``fmpy.ssp.simulate_ssp``) starts every connector at 0
+    and hands the vehicle's wheel heights to TrackContact only after the first step
+    (issue 38, N5: the run failed one step later at 6.06 MN blaming the wheel inputs).
+    With ``inputs.datum = first_step`` TrackContact takes the datum again from the
+    second step's heights, says so once at fmi2Warning naming ``inputs.datum``, the
+    first-step heights and the static ones, and the run is that of a Jacobi loop started
+    at rest (the same exchange, every connector at its partner's initial value)."""
+    import numpy as np
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    from fmpy.ssp.simulation import simulate_ssp
+
+    h = shipped_step("RollPlaneVehicle", "contact")
+    r = simulate_ssp(os.path.join(SYSTEMS, system_name("RollPlaneVehicle", "contact") + ".ssp"),
+                     stop_time=STOP, step_size=h)
+    out = capfd.readouterr().out
+    datum = [x for x in out.splitlines() if "inputs.datum = first_step" in x]
+    assert len(datum) == 1, out[-3000:]
+    assert "wheel.left.z = 0.0000 mm at the first step, -1.5337 mm now (static -1.5336 mm)" in datum[0], datum
+    forces = ["track.contact.left.force", "track.contact.right.force"]
+    # The track held its static state through the first step and the datum's new take.
+    static = r[forces[0]][0]
+    assert abs(r[forces[0]][1] / static - 1) < 0.005, r[forces[0]][:3]
+    ssp_peaks = [r[f].max() for f in forces]
+
+    def slave(name):
+        path = os.path.join(FMU_DIR, name + ".fmu")
+        md = read_model_description(path)
+        s = FMU2Slave(guid=md.guid, unzipDirectory=extract(path),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        return s, {v.name: v.valueReference for v in md.modelVariables}
+
+    (track, tv), (vehicle, vv) = slave("TrackContact"), slave("RollPlaneVehicle")
+    heights = [f"wheel.{x}" for x in ("left.z", "right.z", "rotation")]
+    loads = ["contact.left.force", "contact.right.force"]
+    to_track = vehicle.getReal([vv[k] for k in heights])
+    to_vehicle = track.getReal([tv[k] for k in loads])
+    peaks = np.zeros(2)
+    t = 0.0
+    while t < STOP - h / 2:
+        track.setReal([tv[k] for k in heights], to_track)
+        vehicle.setReal([vv[k] for k in loads], to_vehicle)
+        track.doStep(t, h)
+        vehicle.doStep(t, h)
+        t += h
+        to_track = vehicle.getReal([vv[k] for k in heights])
+        to_vehicle = track.getReal([tv[k] for k in loads])
+        peaks = np.maximum(peaks, to_vehicle)
+    for s in (track, vehicle):
+        s.terminate()
+        s.freeInstance()
+    assert np.allclose(ssp_peaks, peaks, rtol=5e-4), (ssp_peaks, peaks)

@@ -12,8 +12,22 @@
 //! `static_wheel_z.*` first. A height the master sets before the first step within 16
 //! machine epsilons of its static one (16 to 32 units in the last place) is the
 //! partner's rounding of it and moves nothing: no offset.
+//!
+//! The first step alone cannot tell a partner at rest on heights of 0 from one whose
+//! connectors start at 0 (fmpy's `simulate_ssp` starts every connector at 0 and hands
+//! the vehicle's heights over only after the first step), but the next inputs can: a
+//! partner at rest moves by a step's motion, far less than the static deflection. When
+//! an input given between the first and the second step is more than half the static
+//! deflection (`|static|`) away from the first step's, the first step's was not the
+//! partner's rest: the datum is taken again from it, and the step returns fmi2Warning
+//! naming `inputs.datum`, the first-step input and the static height (issue 38, N5).
+//! Any later force beyond the health bound names the datum's offsets when one is more
+//! than half the static deflection ([`InputDatum::explain`]).
 
 use crate::error::{Error, out_of_range};
+
+/// Values of [`InputDatum::state`] per wheelset.
+const STATE: usize = 9;
 
 /// The offsets of the displacement inputs of each wheelset `[left, right]` (m), the
 /// same for both sides' wheel heights (contact interface) or side frames (axle-box
@@ -31,6 +45,30 @@ pub(super) struct InputDatum {
     statics: Vec<[f64; 2]>,
     /// Added to each input (m).
     offsets: Vec<[f64; 2]>,
+    /// Per wheelset: steps since the offsets were fixed, up to 2 (1: between the first
+    /// step and the second, when a move is judged).
+    age: Vec<u8>,
+    /// Per wheelset and side: the first step's input, when the datum was taken again.
+    retaken: Vec<[Option<f64>; 2]>,
+    /// The re-takes not yet warned of: wheelset, side, first input, the input now (m).
+    pending: Vec<(usize, usize, f64, f64)>,
+}
+
+/// The name of displacement input `side` (0 left, 1 right) of wheelset `k` (from 0):
+/// a wheel height, or with `axle_box` a side frame's.
+pub(super) fn input_name(axle_box: bool, k: usize, side: usize) -> String {
+    let what = if axle_box { "sideframe" } else { "wheel" };
+    let side = ["left", "right"][side];
+    if k == 0 {
+        format!("{what}.{side}.z")
+    } else {
+        format!("wheelset[{}].{what}.{side}.z", k + 1)
+    }
+}
+
+/// A length in millimetres for a message.
+fn mm(z: f64) -> String {
+    format!("{:.4} mm", 1e3 * z)
 }
 
 impl InputDatum {
@@ -44,6 +82,9 @@ impl InputDatum {
             fixed: vec![false; n],
             statics,
             offsets: vec![[0.0; 2]; n],
+            age: vec![0; n],
+            retaken: vec![[None; 2]; n],
+            pending: Vec::new(),
         }
     }
 
@@ -92,7 +133,84 @@ impl InputDatum {
                 }
             });
         }
+        if self.age[k] == 1 {
+            // Between the first step and the second: a move of more than half the static
+            // deflection from the first step's input is no partner at rest.
+            for s in (0..2).filter(|&s| set[s]) {
+                let first = self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s]);
+                if (raw[s] - first).abs() > 0.5 * self.statics[k][s].abs() {
+                    self.offsets[k][s] = self.statics[k][s] - raw[s];
+                    if self.retaken[k][s].is_none() {
+                        self.pending.push((k, s, first, raw[s]));
+                    }
+                    self.retaken[k][s] = Some(first);
+                }
+            }
+        }
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
+    }
+
+    /// The warning for the datum taken again since the last call (`axle_box`: the
+    /// inputs are side frames'), at time `time` (s); `None` when it was not.
+    pub(super) fn take_warning(&mut self, axle_box: bool, time: f64) -> Option<String> {
+        if self.pending.is_empty() {
+            return None;
+        }
+        let moves: Vec<String> = (self.pending.drain(..))
+            .map(|(k, s, first, now)| {
+                format!(
+                    "{} = {} at the first step, {} now (static {})",
+                    input_name(axle_box, k, s),
+                    mm(first),
+                    mm(now),
+                    mm(self.statics[k][s])
+                )
+            })
+            .collect();
+        Some(format!(
+            "at t = {time} s the displacement inputs moved by more than half the static \
+             deflection since the first step: {}. With inputs.datum = first_step the first \
+             step's inputs stand for the static heights, but these were not the partner's \
+             rest (connectors that start at 0, as fmpy's simulate_ssp starts them, before \
+             the partner's heights come in): the datum is taken from this step's inputs \
+             instead, and the track's first step held its static state. Start the \
+             partner's connectors at its static heights, or set inputs.datum = absolute and \
+             hand the partner the track's static_wheel_z.* first",
+            moves.join("; ")
+        ))
+    }
+
+    /// Why a force beyond the health bound may be the datum's doing, in words: the
+    /// offsets of more than half the static deflection (`axle_box`: the inputs are side
+    /// frames'); `None` when there are none or the inputs are absolute.
+    pub(super) fn explain(&self, axle_box: bool) -> Option<String> {
+        if !self.relative {
+            return None;
+        }
+        let large: Vec<String> = (0..self.offsets.len())
+            .flat_map(|k| (0..2).map(move |s| (k, s)))
+            .filter(|&(k, s)| {
+                self.fixed[k] && self.offsets[k][s].abs() > 0.5 * self.statics[k][s].abs()
+            })
+            .map(|(k, s)| {
+                let first = self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s]);
+                format!(
+                    "{} was {} at the first step, taken for its static {} (offset {})",
+                    input_name(axle_box, k, s),
+                    mm(first),
+                    mm(self.statics[k][s]),
+                    mm(self.offsets[k][s])
+                )
+            })
+            .collect();
+        (!large.is_empty()).then(|| {
+            format!(
+                "inputs.datum = first_step moves every input by the offset from its first \
+                 step's value to the static height: {}; if the partner was not at rest on \
+                 those first inputs, start it at rest or set inputs.datum = absolute",
+                large.join("; ")
+            )
+        })
     }
 
     /// Whether the inputs are measured from the first step's (`first_step`).
@@ -109,17 +227,25 @@ impl InputDatum {
     /// A step is taken: the offsets of every wheelset whose inputs were given stay as
     /// they are.
     pub(super) fn fix(&mut self) {
-        for (f, g) in self.fixed.iter_mut().zip(&self.given) {
-            *f |= *g;
+        for k in 0..self.fixed.len() {
+            if self.fixed[k] {
+                self.age[k] = (self.age[k] + 1).min(2);
+            } else if self.given[k] {
+                self.fixed[k] = true;
+                self.age[k] = 1;
+            }
         }
     }
 
     /// Values of [`InputDatum::state`].
     pub(super) fn state_len(&self) -> usize {
-        4 * self.offsets.len()
+        STATE * self.offsets.len()
     }
 
-    /// Per wheelset: given (0 or 1), fixed (0 or 1), the offsets `[left, right]` (m).
+    /// Per wheelset: given (0 or 1), fixed (0 or 1), the offsets `[left, right]` (m),
+    /// the steps since fixed (0 to 2), and per side whether the datum was taken again
+    /// (0 or 1) and the first step's input then (m, else 0). A re-take not yet warned of is
+    /// warned of in the run it happened in, not in a restored one.
     pub(super) fn state(&self) -> Vec<f64> {
         let flag = |b: bool| f64::from(u8::from(b));
         (0..self.offsets.len())
@@ -129,6 +255,11 @@ impl InputDatum {
                     flag(self.fixed[k]),
                     self.offsets[k][0],
                     self.offsets[k][1],
+                    f64::from(self.age[k]),
+                    flag(self.retaken[k][0].is_some()),
+                    self.retaken[k][0].unwrap_or(0.0),
+                    flag(self.retaken[k][1].is_some()),
+                    self.retaken[k][1].unwrap_or(0.0),
                 ]
             })
             .collect()
@@ -140,25 +271,37 @@ impl InputDatum {
     /// finite.
     pub(super) fn restore(&mut self, v: &[f64]) -> Result<(), Error> {
         let flag = |x: f64| x == 0.0 || x == 1.0;
+        let metres = |x: &f64| x.is_finite() && x.abs() <= 1.0;
         let ok = v.len() == self.state_len()
-            && v.chunks(4).all(|c| {
-                flag(c[0]) && flag(c[1]) && c[2..].iter().all(|x| x.is_finite() && x.abs() <= 1.0)
+            && v.chunks(STATE).all(|c| {
+                flag(c[0])
+                    && flag(c[1])
+                    && c[2..4].iter().all(metres)
+                    && [0.0, 1.0, 2.0].contains(&c[4])
+                    && flag(c[5])
+                    && metres(&c[6])
+                    && flag(c[7])
+                    && metres(&c[8])
             });
         if !ok {
             return Err(out_of_range(
                 "state: input datum",
                 v.len() as f64,
                 format!(
-                    "{} values: per wheelset two flags 0 or 1, then offsets within 1 m",
+                    "{} values: per wheelset two flags 0 or 1, offsets within 1 m, steps 0 to \
+                     2, per side a flag 0 or 1 and a first input within 1 m",
                     self.state_len()
                 ),
             ));
         }
-        for (k, c) in v.chunks(4).enumerate() {
+        for (k, c) in v.chunks(STATE).enumerate() {
             self.given[k] = c[0] == 1.0;
             self.fixed[k] = c[1] == 1.0;
             self.offsets[k] = [c[2], c[3]];
+            self.age[k] = c[4] as u8;
+            self.retaken[k] = [(c[5], c[6]), (c[7], c[8])].map(|(f, x)| (f == 1.0).then_some(x));
         }
+        self.pending.clear();
         Ok(())
     }
 }
@@ -185,7 +328,7 @@ mod tests {
         assert!((z[0] - (-1.5e-3 - 0.1e-3)).abs() < 1e-15, "{z:?}");
         assert!((z[1] - (-1.6e-3 + 0.1e-3)).abs() < 1e-15, "{z:?}");
         // The state continues exactly.
-        let mut e = InputDatum::new(true, vec![[0.0; 2]]);
+        let mut e = InputDatum::new(true, vec![[-1.5e-3, -1.6e-3]]);
         e.restore(&d.state()).unwrap();
         assert_eq!(e.apply(0, [-1.50e-3, -1.28e-3], [true; 2], false), z);
         assert!(e.restore(&[2.0, 0.0, 0.0, 0.0]).is_err());
@@ -242,5 +385,64 @@ mod tests {
             f.apply(0, rounded, [true, false], true),
             [rounded[0], statics[1]]
         );
+    }
+
+    #[test]
+    fn a_move_of_more_than_half_the_static_deflection_after_the_first_step_takes_the_datum_again() {
+        // fmpy's simulate_ssp: connectors at 0 for the first step, the partner's heights
+        // at rest from the second on (issue 38, N5).
+        let statics = [-1.5e-3, -1.6e-3];
+        let mut d = InputDatum::new(true, vec![statics]);
+        assert_eq!(d.apply(0, [0.0; 2], [true; 2], true), statics);
+        d.fix();
+        assert!(d.explain(false).is_some(), "0 taken for -1.5 mm is named");
+        // Half the static deflection and less is a move: the offsets stay.
+        let z = d.apply(0, [-0.74e-3, 0.0], [true, false], false);
+        assert!((z[0] - (-1.5e-3 - 0.74e-3)).abs() < 1e-15, "{z:?}");
+        assert_eq!(d.take_warning(false, 0.1), None);
+        // The partner's rest comes in: the datum is taken from it.
+        let rest = [-1.52e-3, -1.61e-3];
+        assert_eq!(d.apply(0, rest, [true; 2], false), statics);
+        let w = d.take_warning(false, 2e-5).unwrap();
+        for part in [
+            "t = 0.00002 s",
+            "wheel.left.z = 0.0000 mm at the first step, -1.5200 mm now (static -1.5000 mm)",
+            "wheel.right.z = 0.0000 mm at the first step, -1.6100 mm now (static -1.6000 mm)",
+            "inputs.datum = first_step",
+            "inputs.datum = absolute",
+        ] {
+            assert!(w.contains(part), "{part}: {w}");
+        }
+        assert_eq!(d.take_warning(false, 3e-5), None, "warned once");
+        assert_eq!(d.explain(false), None, "the offsets are small again");
+        // The state carries it; after the second step nothing is taken again.
+        let mut e = InputDatum::new(true, vec![[0.0; 2]]);
+        e.restore(&d.state()).unwrap();
+        assert_eq!(e.state(), d.state());
+        d.fix();
+        let z = d.apply(0, [0.0; 2], [true; 2], false);
+        assert!((z[0] - (-1.5e-3 + 1.52e-3)).abs() < 1e-15, "{z:?}");
+        assert_eq!(d.take_warning(true, 1.0), None);
+        // A first step on 0 that nothing took again is named by a later error.
+        let mut f = InputDatum::new(true, vec![statics]);
+        f.apply(0, [0.0; 2], [true; 2], true);
+        f.fix();
+        f.fix();
+        f.apply(0, [-1.0e-3; 2], [true; 2], false);
+        assert_eq!(f.take_warning(true, 1.0), None);
+        let named = f.explain(true).unwrap();
+        assert!(
+            named.contains(
+                "sideframe.left.z was 0.0000 mm at the first step, taken for its static \
+                 -1.5000 mm (offset -1.5000 mm)"
+            ),
+            "{named}"
+        );
+        // Absolute inputs are never moved.
+        let mut a = InputDatum::new(false, vec![statics]);
+        a.apply(0, [0.0; 2], [true; 2], true);
+        a.fix();
+        assert_eq!(a.apply(0, rest, [true; 2], false), rest);
+        assert_eq!((a.take_warning(false, 0.0), a.explain(false)), (None, None));
     }
 }

@@ -112,10 +112,16 @@ impl FmuModel {
             }
             _ => "the run diverged, or its parameters are far from a railway",
         };
+        // The input datum's offsets, where they may explain it.
+        let datum = match self.kind {
+            Kind::TrackContact => self.datum.explain(axle_box),
+            _ => None,
+        };
+        let datum = datum.map_or(String::new(), |d| format!("; {d}"));
         OutputFault {
             message: format!(
                 "`{}` = {} N at t = {time} s is beyond {} N ({FORCE_LIMIT_FACTOR} times the \
-                 static wheel load), which no physical run reaches: {cause}",
+                 static wheel load), which no physical run reaches: {cause}{datum}",
                 spec.name,
                 num(x),
                 num(self.force_limit),

@@ -62,6 +62,20 @@ impl FmuModel {
         let Engine::Sim(sim) = &self.engine else {
             return None;
         };
+        // The input datum taken again from the second step's inputs (`datum.rs`) comes
+        // first; the contact watch below follows every step all the same.
+        let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
+        let datum = self.datum.take_warning(axle_box, time);
+        let other = self.track_warning(time);
+        datum.map(|w| ("input datum", w)).or(other)
+    }
+
+    /// [`FmuModel::warning_after_step`] for the units that carry the track: the contact
+    /// watch, the fixed rail end's zone.
+    fn track_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
+        let Engine::Sim(sim) = &self.engine else {
+            return None;
+        };
         // TrackContact at the contact interface: what it sees of the exchange (the
         // watch follows every step, whichever warning is returned).
         let mut contact = None;
