@@ -28,7 +28,7 @@ pub enum Error {
     OffTrack {
         /// Wheel position along the track (m).
         position: f64,
-        /// Track length (m).
+        /// The track's running length (m), [`crate::track::TrackParams::running_length`].
         length: f64,
         /// Simulation time (s).
         time: f64,
@@ -107,8 +107,10 @@ impl fmt::Display for Error {
                 time,
             } => write!(
                 f,
-                "wheel at position {position} m is outside the track (0, {length}) m at t = {time} s: \
-                 lengthen the track, shorten the run or move the start position"
+                "wheel at position {position} m is outside the track's running length (0, \
+                 {length}) m at t = {time} s (the last span, to the fixed rail end, carries no \
+                 wheel: the clamped end holds the rail at zero there): lengthen the track, \
+                 shorten the run or move the start position"
             ),
             Error::NonFinite { what, time } => {
                 write!(f, "{what} became non-finite at t = {time} s")

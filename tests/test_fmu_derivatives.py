@@ -215,11 +215,13 @@ def test_the_axle_box_step_estimate_covers_the_primary_springs_and_dampers(paths
     b.fmu.exitInitializationMode()
     status = [step_status(b, k * 1e-3, 1e-3) for k in range(3)]
     if warned:
-        # Every step beyond the estimate returns fmi2Warning; the message once, then a
-        # line that it still holds.
-        assert status == [1, 1, 1], status
+        # The first step beyond the estimate returns fmi2Warning with the message; the
+        # steps after it, the same step beyond the same estimate, return fmi2OK and log
+        # nothing (issue 38: a warning at every step stopped C fmusim, PyFMI and
+        # OMSimulator).
+        assert status == [1, 0, 0], status
         text = log.text()
-        assert "axle-box exchange stays stable" in text and "still: axle-box step" in text, text
+        assert text.count("axle-box exchange stays stable") == 1 and "still" not in text, text
     else:
         assert status == [0, 0, 0] and "axle-box" not in log.text(), log.text()
     b.close()

@@ -315,7 +315,7 @@ impl Simulation {
         let track = match &track_spec {
             TrackSpec::Discrete(p) => {
                 p.validate()?;
-                let len = p.length();
+                let len = p.running_length();
                 for w in wheelsets.iter() {
                     let x = w.position(s.start_position) - origin;
                     if !(x > 0.0 && x < len) {
@@ -323,7 +323,8 @@ impl Simulation {
                             "start_position",
                             s.start_position,
                             format!(
-                                "every wheelset inside the track, 0 < x < {len} m (wheelset at \
+                                "every wheelset on the track's running length, 0 < x < {len} m \
+                                 (the last span, to the fixed rail end, carries no wheel; wheelset at \
                                  {} m behind the leading one: {} m; an endless track, \
                                  track.window.ahead > 0, carries wheelsets anywhere)",
                                 num(w.offset()),

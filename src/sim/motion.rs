@@ -167,7 +167,8 @@ impl Simulation {
         let v = self.motion.speed;
         match &self.track {
             TrackState::Discrete(t) if v > 0.0 && self.window.is_none() => {
-                Some(self.time() + (t.params().length() - (self.position() - self.origin)) / v)
+                let end = t.params().running_length();
+                Some(self.time() + (end - (self.position() - self.origin)) / v)
             }
             _ => None,
         }

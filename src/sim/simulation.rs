@@ -234,7 +234,7 @@ impl Simulation {
     fn step_body(&mut self) -> Result<Sample> {
         let x = self.position();
         if let TrackState::Discrete(t) = &self.track {
-            let len = t.params().length();
+            let len = t.params().running_length();
             let xt = x - self.origin;
             if !(xt > 0.0 && xt < len) {
                 return Err(Error::OffTrack {
@@ -317,7 +317,7 @@ impl Simulation {
     /// stops it with [`Error::Diverged`].
     pub fn advance_steps(&mut self, n: u64) -> Result<()> {
         if let (TrackState::Discrete(t), None) = (&self.track, &self.window) {
-            let len = t.params().length();
+            let len = t.params().running_length();
             let t_end = self.clock.time_after(n);
             let m = &self.motion;
             let end = m.x_ref + m.speed * (t_end - m.t_ref);

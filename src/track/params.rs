@@ -159,6 +159,16 @@ impl TrackParams {
         self.sleeper_spacing * self.spans as f64
     }
 
+    /// How far along a fixed track a wheel may run (m): to the last sleeper but one,
+    /// `(N - 1) a`. The last span ends at the fixed rail end, which holds the rail at
+    /// zero (`Z = theta = 0`): a wheel there rides a rail that cannot deflect, and one
+    /// held at its static height presses it beyond the health bound within about 6 cm
+    /// of the end (issue 38); its impact forces are 20 to 35 % high already. A run ends
+    /// there ([`crate::Error::OffTrack`]).
+    pub fn running_length(&self) -> f64 {
+        self.sleeper_spacing * (self.spans as f64 - 1.0)
+    }
+
     /// Critical time step of the explicit scheme (s) and the part of the model that
     /// sets it.
     ///

@@ -9,7 +9,7 @@ use super::outputs::Published;
 use super::parameters::{check_table, scenario, vehicle_unit_params, with_tables};
 use super::watch::ContactWatch;
 use crate::error::{Error, num};
-use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault};
+use crate::fmu::fmi2::{Model, OutputFault, StepError, StepFault, StepWarning};
 use crate::fmu::vars::{FmuTable, TRAILING, VarSpec, enums, vr};
 use crate::limits::{FORCE_LIMIT_FACTOR, force_limit, within};
 use crate::sim::{Sample, Simulation, TrackSpec, VehicleState, VehicleUnit};
@@ -331,8 +331,8 @@ impl Model for FmuModel {
     /// communication step above the Jacobi estimate of [`VehicleUnit::exchange_limits`]; for
     /// TrackContact at the contact interface, what its contact watch sees (`watch.rs`); for a vehicle's
     /// first step, forces off its forces at rest.
-    fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
-        self.warning_after_step(time)
+    fn step_warning(&mut self, time: f64, at_stop: bool) -> Option<StepWarning> {
+        self.warning_after_step(time, at_stop)
     }
 
     /// The engine's state, then TrackContact's input datum.
@@ -455,7 +455,7 @@ impl FmuModel {
             TrackSpec::Lumped(_) => f64::NAN,
         };
         Some(format!(
-            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track at \
+            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track's running length (its last sleeper but one) at \
              t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
              stopTime, and the endless track (track.window.ahead > 0, the default; 20 m is \
              the converged window) any stopTime",

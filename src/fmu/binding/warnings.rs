@@ -6,6 +6,7 @@ use super::Kind;
 use super::unit::{END_ZONE_SPANS, Engine, FmuModel};
 use super::watch::{HELD_STEPS, INTERPOLATED_STEPS};
 use crate::error::num;
+use crate::fmu::fmi2::StepWarning;
 use crate::sim::{TrackSpec, VehicleState, VehicleUnit};
 
 impl FmuModel {
@@ -16,14 +17,14 @@ impl FmuModel {
     /// TrackContact at the contact interface, what its contact watch sees (`watch.rs`); for a vehicle's
     /// first step, forces off its forces at rest.
     #[inline]
-    pub(super) fn warning_after_step(&mut self, time: f64) -> Option<(&'static str, String)> {
+    pub(super) fn warning_after_step(&mut self, time: f64, at_stop: bool) -> Option<StepWarning> {
         if let Engine::Vehicle(u) = &self.engine {
             // The forces that drove the first step against those that hold this vehicle
             // at rest: a partner that does not carry it at rest.
             if !self.started {
                 self.started = true;
                 if let Some(w) = off_rest(u) {
-                    return Some(("static load", w));
+                    return Some(StepWarning::once("static load", w));
                 }
             }
             let e = u.exchange_limits()?;
@@ -56,7 +57,11 @@ impl FmuModel {
                         num(e.sequential)
                     )
                 };
-                ("axle-box step", message)
+                StepWarning {
+                    kind: "axle-box step",
+                    message,
+                    severity: h / e.jacobi,
+                }
             });
         }
         let Engine::Sim(sim) = &self.engine else {
@@ -66,13 +71,13 @@ impl FmuModel {
         // first; the contact watch below follows every step all the same.
         let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
         let datum = self.datum.take_warning(axle_box, time);
-        let other = self.track_warning(time);
-        datum.map(|w| ("input datum", w)).or(other)
+        let other = self.track_warning(time, at_stop);
+        datum.map(|w| StepWarning::once("input datum", w)).or(other)
     }
 
     /// [`FmuModel::warning_after_step`] for the units that carry the track: the contact
     /// watch, the fixed rail end's zone.
-    fn track_warning(&mut self, time: f64) -> Option<(&'static str, String)> {
+    fn track_warning(&mut self, time: f64, at_stop: bool) -> Option<StepWarning> {
         let Engine::Sim(sim) = &self.engine else {
             return None;
         };
@@ -93,7 +98,7 @@ impl FmuModel {
             let ratio = self.last_step / sim.dt();
             let most = if held { HELD_STEPS } else { INTERPOLATED_STEPS };
             contact = if let Some(name) = chatter {
-                Some((
+                Some(StepWarning::once(
                     "contact chatter",
                     format!(
                         "at t = {time} s {name} has jumped up and down at each of the last \
@@ -107,8 +112,9 @@ impl FmuModel {
                     ),
                 ))
             } else if let Some((j, name)) = jump {
-                Some((
+                Some(StepWarning::worse(
                     "contact exchange",
+                    j / load,
                     format!(
                         "at t = {time} s {name} jumped by {} N ({:.0} % of the static load) when \
                      the wheel heights of this communication point came in: the heights the \
@@ -124,8 +130,13 @@ impl FmuModel {
                         num(sim.dt())
                     ),
                 ))
-            } else if self.watch.is_coupled() && (ratio - ratio.round()).abs() > 1e-3 {
-                Some((
+            } else if self.watch.is_coupled()
+                && (ratio - ratio.round()).abs() > 1e-3
+                && !(at_stop && ratio < 1.0)
+            {
+                // A last step shorter than the track's, which every master takes when the
+                // stop time is not a whole number of track steps, is no reason to warn.
+                Some(StepWarning::once(
                     "contact step grid",
                     format!(
                         "at t = {time} s the communication step {} s is {ratio:.3} track steps \
@@ -138,8 +149,9 @@ impl FmuModel {
                     ),
                 ))
             } else if ratio > most && self.watch.is_coupled() {
-                Some((
+                Some(StepWarning::worse(
                     "contact step",
+                    ratio / most,
                     format!(
                         "at t = {time} s the communication step {} s is {ratio:.1} track steps \
                      (solver.step = {} s) with {}: the contact exchange's error grows with \
@@ -161,7 +173,7 @@ impl FmuModel {
             } else {
                 self.watch
                     .rate_warning()
-                    .map(|m| ("axle rate", format!("at t = {time} s {m}")))
+                    .map(|m| StepWarning::once("axle rate", format!("at t = {time} s {m}")))
             };
         }
         let TrackSpec::Discrete(p) = &sim.scenario().track else {
@@ -175,18 +187,19 @@ impl FmuModel {
         if x <= zone {
             return contact;
         }
-        Some({
-            (
-                "rail end",
-                format!(
-                    "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans \
+        Some(StepWarning::once(
+            "rail end",
+            format!(
+                "at t = {time} s the wheel is at {x:.3} m, within {END_ZONE_SPANS} sleeper spans \
                  of the fixed rail end at {:.3} m: the end's reflections raise impact forces \
-                 here (by 20 to 35 % within the last span); keep the impacts of interest at \
-                 least {END_ZONE_SPANS} spans from the ends (track.spans)",
-                    p.length()
-                ),
-            )
-        })
+                 here (by 20 to 35 % near the last sleeper but one); the run ends with \
+                 fmi2Discard at that sleeper, {:.3} m (the last span carries no wheel); keep \
+                 the impacts of interest at least {END_ZONE_SPANS} spans from the ends \
+                 (track.spans)",
+                p.length(),
+                p.running_length()
+            ),
+        ))
     }
 }
 

@@ -44,9 +44,10 @@ pub struct Instance<M: Model> {
     /// Why the run cannot go on (a value beyond the health bounds): `fmi2DoStep` and
     /// outputs are refused until `fmi2Reset` or `fmi2SetFMUstate`.
     pub(super) failed: Option<String>,
-    /// The kinds of step warning ([`Model::step_warning`]) logged: each once per run,
-    /// until `fmi2Reset` (FMU states leave them as they are).
-    pub(super) step_warned: Vec<&'static str>,
+    /// The kinds of step warning ([`Model::step_warning`]) warned of in this run, with
+    /// the severity last warned of, until `fmi2Reset` (FMU states leave them as they
+    /// are).
+    pub(super) step_warned: Vec<(&'static str, f64)>,
     logger: Logger,
     logging_on: bool,
     categories: [bool; 4],

@@ -20,6 +20,43 @@ pub enum StepFault {
     Stopped,
 }
 
+/// How many times worse a condition warned of must become to be warned of again
+/// ([`Model::step_warning`]).
+pub const WORSENED: f64 = 2.0;
+
+/// A condition a successful step ends in, for `fmi2DoStep` to warn of
+/// ([`Model::step_warning`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepWarning {
+    /// The kind: a short fixed name.
+    pub kind: &'static str,
+    /// What it is, with its numbers, and what to do.
+    pub message: String,
+    /// How bad it is, in the kind's own measure (> 0): warned of again once it reaches
+    /// [`WORSENED`] times the severity last warned of.
+    pub severity: f64,
+}
+
+impl StepWarning {
+    /// A condition of one degree: warned of when it starts.
+    pub fn once(kind: &'static str, message: String) -> Self {
+        StepWarning {
+            kind,
+            message,
+            severity: 1.0,
+        }
+    }
+
+    /// A condition of severity `severity` (> 0, the kind's own measure).
+    pub fn worse(kind: &'static str, severity: f64, message: String) -> Self {
+        StepWarning {
+            kind,
+            message,
+            severity,
+        }
+    }
+}
+
 /// Why `fmi2DoStep` did not complete.
 #[derive(Debug)]
 pub enum StepError {
@@ -128,11 +165,12 @@ pub trait Model: Clone + Sized {
     fn step_fault(e: &Error) -> StepFault;
 
     /// A warning about the state after a successful step at the communication time
-    /// `time` (s): its kind (a short fixed name) and the message. `fmi2DoStep` returns
-    /// `fmi2Warning` after every step the condition holds, with the message the first
-    /// time of each kind in a run (until `fmi2Reset`) and a line that it still holds
-    /// after.
-    fn step_warning(&mut self, time: f64) -> Option<(&'static str, String)>;
+    /// `time` (s); `at_stop`: the step ended at the experiment's stop time.
+    /// `fmi2DoStep` returns `fmi2Warning` with its message when the condition starts
+    /// (the first time of its kind in a run, until `fmi2Reset`) and when it has
+    /// worsened [`WORSENED`] times since it was last warned of; at the steps between,
+    /// while it holds, `fmi2OK` and nothing logged.
+    fn step_warning(&mut self, time: f64, at_stop: bool) -> Option<StepWarning>;
 
     /// Everything that determines the continuation, for serialized FMU states.
     fn state_vector(&self) -> Result<Vec<f64>, Error>;

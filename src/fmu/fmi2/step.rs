@@ -3,7 +3,7 @@
 
 use super::calls::{Call, Phase};
 use super::instance::Instance;
-use super::model::{Model, StepError, StepFault};
+use super::model::{Model, StepError, StepFault, WORSENED};
 use super::status::{FmiResult, Status};
 use crate::error::num;
 
@@ -105,17 +105,25 @@ impl<M: Model> Instance<M> {
             return self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
         }
         self.time = end;
-        let warning = self.model.as_mut().and_then(|m| m.step_warning(end));
-        if let Some((kind, w)) = warning {
-            // The step was taken: the warning is the status. FMI 2.0 expects the logger
-            // called with every fmi2Warning: the whole message the first time of each
-            // kind in a run, a line that it still holds after.
-            let message = if self.step_warned.contains(&kind) {
-                format!("fmi2DoStep: at t = {end} s still: {kind} (as warned before)")
-            } else {
-                self.step_warned.push(kind);
-                format!("fmi2DoStep: {w}")
-            };
+        // The step ended at stopTime (to the clock's rounding): a last step.
+        let at_stop = self.stop_time.is_some_and(|s| (s - end).abs() <= clock);
+        let warning = self
+            .model
+            .as_mut()
+            .and_then(|m| m.step_warning(end, at_stop));
+        if let Some(w) = warning {
+            // FMI 2.0 (2.1.3): fmi2Warning reports a non-critical problem when it is
+            // detected, and the logger is called with it. A condition is detected when it
+            // starts and when it worsens WORSENED times; a step that ends in it unchanged
+            // detects nothing new and returns fmi2OK, logging nothing (a warning at every
+            // step stopped C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
+            let last = self.step_warned.iter_mut().find(|(k, _)| *k == w.kind);
+            match last {
+                Some((_, s)) if w.severity < WORSENED * *s => return Ok(()),
+                Some((_, s)) => *s = w.severity,
+                None => self.step_warned.push((w.kind, w.severity)),
+            }
+            let message = format!("fmi2DoStep: {}", w.message);
             self.warn(&message);
             return Err(super::status::Refusal {
                 status: Status::Warning,

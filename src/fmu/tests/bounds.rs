@@ -187,14 +187,15 @@ fn an_unreachable_stop_time_is_named_at_initialisation() {
     i.do_step(0.0, 1e-3).unwrap();
     let log = log.lock().unwrap();
     assert_eq!(log.len(), 1);
-    // 30 spans of 0.685 m from 1.37 m at 70 km/h: the end at 0.986 s; 2 s needs
-    // 1.37 + 38.9 m of track, 59 spans, plus the two kept clear of the end.
+    // 30 spans of 0.685 m from 1.37 m at 70 km/h: the last sleeper but one (19.865 m)
+    // at 0.951 s; 2 s needs 1.37 + 38.9 m of track, 59 spans, plus the two kept clear
+    // of the end.
     assert!(
         log[0].contains("stopTime = 2 s cannot be reached"),
         "{}",
         log[0]
     );
-    assert!(log[0].contains("t = 0.986"), "{}", log[0]);
+    assert!(log[0].contains("t = 0.951"), "{}", log[0]);
     assert!(log[0].contains("track.spans >= 61"), "{}", log[0]);
 }
 
@@ -412,7 +413,11 @@ fn a_track_too_soft_to_carry_the_load_is_refused_naming_its_support() {
 }
 
 #[test]
-fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_per_run() {
+fn the_track_end_is_warned_of_once_and_a_run_ends_with_discard_at_the_last_sleeper_but_one() {
+    // Issue 38 (N10): the zone's warning came at every step (1,762 "still: rail end"
+    // lines in a 12-span run), which stops C fmusim, PyFMI and OMSimulator; standalone
+    // TrackContact with the wheel held at its static height failed at the health bound
+    // (2.157 MN at 0.9835 s) before its fmi2Discard at the rail end (0.9864 s).
     let (mut i, log) = fixed_track_instance(Kind::CoupledSystem);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
@@ -420,11 +425,12 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
         log.lock()
             .unwrap()
             .iter()
-            .filter(|m| m.contains("fixed rail end") && !m.contains("still"))
+            .filter(|m| m.contains("fixed rail end"))
             .count()
     };
     // The fixed track: 30 spans of 0.685 m, 20.55 m; the zone starts two spans before
-    // the end, at 19.18 m, which the wheel reaches from 1.37 m at 70 km/h at 0.916 s.
+    // the end, at 19.18 m, which the wheel reaches from 1.37 m at 70 km/h at 0.916 s;
+    // the last sleeper but one, 19.865 m, at 0.951 s.
     let h = 1e-3;
     let mut t = 0.0;
     while t < 0.9 - 1e-9 {
@@ -433,29 +439,33 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
     }
     assert_eq!(warnings(&log), 0, "not yet in the zone at {t} s");
     let before = i.get_state().unwrap();
-    // Every step in the zone returns fmi2Warning (the step is taken); the message is
-    // logged once, a line that it still holds after.
+    // The step that enters the zone (the 16th, ending at 0.916 s) returns fmi2Warning
+    // and logs the message; the steps after it in the zone return fmi2OK and log
+    // nothing.
     let mut statuses = Vec::new();
     while t < 0.93 - 1e-9 {
         statuses.push(i.do_step(t, h).map_err(|r| r.status));
         t = i.time();
     }
-    // The zone from 0.916 s: the step that ends at 0.916 s is the 16th.
-    assert!(statuses[..15].iter().all(|s| s.is_ok()), "{statuses:?}");
+    let warned: Vec<usize> = (0..statuses.len())
+        .filter(|&k| statuses[k] == Err(Status::Warning))
+        .collect();
+    assert_eq!(warned, [15], "{statuses:?}");
     assert!(
-        statuses[15..].iter().all(|s| *s == Err(Status::Warning)),
-        "{statuses:?}"
+        statuses
+            .iter()
+            .all(|s| s.is_ok() || *s == Err(Status::Warning))
     );
     assert_eq!(warnings(&log), 1);
     let after = i.get_state().unwrap();
     let bytes = i.serialize(&after).unwrap();
     let restored = i.deserialize(&bytes).unwrap();
-    // Restoring a state, in memory or serialized, before or in the zone, does not
-    // warn again in the same run.
+    // Restoring a state, in memory or serialized, before or in the zone, does not warn
+    // again in the same run.
     for s in [&after, &restored, &before] {
         i.set_state(s).unwrap();
         let t = i.time();
-        assert_eq!(i.do_step(t, 0.02).unwrap_err().status, Status::Warning);
+        i.do_step(t, 0.02).unwrap();
         assert_eq!(warnings(&log), 1);
     }
     // A new run warns again.
@@ -466,6 +476,45 @@ fn the_track_end_warning_is_returned_at_every_step_in_the_zone_and_logged_once_p
     let t = i.time();
     assert_eq!(i.do_step(t, h).unwrap_err().status, Status::Warning);
     assert_eq!(warnings(&log), 2);
+    // To the end: the step that would carry the wheel past the last sleeper but one
+    // ends the run with fmi2Discard, outputs readable, no error before.
+    let mut t = i.time();
+    let ended = loop {
+        match i.do_step(t, h) {
+            Ok(()) => t = i.time(),
+            Err(e) => break e,
+        }
+        real(&mut i, vr::CONTACT_LEFT_FORCE);
+    };
+    assert_eq!(ended.status, Status::Discard, "{}", ended.message);
+    assert!(
+        ended.message.contains("running length (0, 19.865"),
+        "{}",
+        ended.message
+    );
+    assert!((t - 0.951).abs() < 1e-3, "{t}");
+    assert!(i.terminated_by_model());
+
+    // Standalone TrackContact, its wheels held at their static heights (never set):
+    // the same end, no force beyond the health bound before it.
+    let (mut i, _) = fixed_track_instance(Kind::TrackContact);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let mut t = 0.0;
+    let ended = loop {
+        match i.do_step(t, h) {
+            Err(e) if e.status != Status::Warning => break e,
+            _ => t = i.time(),
+        }
+        for r in [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE] {
+            let mut x = [0.0];
+            if let Err(e) = i.get_real(&[r], &mut x) {
+                panic!("at t = {t} s: {}", e.message);
+            }
+        }
+    };
+    assert_eq!(ended.status, Status::Discard, "{}", ended.message);
+    assert!((t - 0.951).abs() < 1e-3, "{t}");
 }
 
 #[test]

@@ -37,6 +37,7 @@ fn first_impact(h: f64, set_heights: bool) -> (f64, f64) {
     i.get_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z], &mut z)
         .unwrap();
     let (mut first, mut peak) = (0.0, 0.0f64);
+    let first_set = (0.01 / h).round() as usize;
     for k in 0..(0.06 / h).round() as usize {
         let t = k as f64 * h;
         if set_heights && t >= 0.01 {
@@ -48,8 +49,9 @@ fn first_impact(h: f64, set_heights: bool) -> (f64, f64) {
         if p[0] > peak {
             (first, peak) = (t, p[0]);
         }
-        // Once the master sets the heights, a step of 7 track steps is warned of.
-        stepped(i.do_step(t, h), set_heights && t >= 0.01);
+        // Once the master sets the heights, a step of 7 track steps is warned of, at
+        // the first step it holds (issue 38: not at every step while unchanged).
+        stepped(i.do_step(t, h), set_heights && k == first_set);
     }
     (first, peak)
 }
