@@ -1,9 +1,11 @@
 """Builds the wheelflat wheel from this checkout (see pyproject.toml): the Python
 package plus, under ``wheelflat_study/_data``, the case runner (``bin/wheelflat_case``),
-the five FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs and
-the git commit. cargo builds the runner and the FMUs' library first (quick when they
-are up to date); fmu/*.fmu are packed again when older than the library. The wheel is
-tagged for this platform (py3-none-linux_x86_64): it holds a native program."""
+the five FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs, the
+newest glibc symbol version they need and the git commit. Both come from the one build
+of the FMUs, scripts/build_fmus_glibc228.sh (the README's main command's), against the
+glibc 2.28 baseline (quick when up to date; it packs fmu/ again); the wheel is refused
+when anything in it needs a newer glibc. The wheel is tagged for this platform
+(py3-none-linux_x86_64): it holds a native program."""
 
 import os
 import re
@@ -28,21 +30,25 @@ def cargo_version():
 
 
 def built():
-    """The case runner and the FMUs' folder, built with cargo when needed."""
+    """The case runner, the FMUs' folder and the newest glibc symbol version they need
+    (e.g. "2.28"), built through scripts/build_fmus_glibc228.sh."""
     if not os.path.isfile(os.path.join(ROOT, "Cargo.toml")):
         sys.exit("the wheelflat wheel is built from a checkout of the repository (python/ inside it)")
-    target = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target", "release")
+    sys.path.insert(0, HERE)
+    import wheelflat_fmus as wf
     try:
-        subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "wheelflat_case",
-                               "--bin", "build_fmus"], cwd=ROOT)
-    except OSError:
-        sys.exit("building the wheelflat wheel needs Rust's cargo on PATH (https://rustup.rs)")
-    fmu_dir = os.path.join(ROOT, "fmu")
-    library = os.path.join(target, "libwheelflat.so")
-    fmus = [os.path.join(fmu_dir, n + ".fmu") for n in FMUS]
-    if not all(os.path.isfile(f) and os.path.getmtime(f) >= os.path.getmtime(library) for f in fmus):
-        subprocess.check_call([os.path.join(target, "build_fmus"), fmu_dir], cwd=ROOT, stdout=subprocess.DEVNULL)
-    return os.path.join(target, "wheelflat_case"), fmu_dir
+        paths = wf.build_fmus()
+    except (OSError, subprocess.CalledProcessError) as e:
+        sys.exit(f"building the wheelflat wheel: {wf.BUILD_SCRIPT} failed ({e}); it needs bash, Rust's cargo "
+                 "(https://rustup.rs), pip and binutils")
+    needed = set()
+    for path in [wf.RUNNER_228] + [paths[n] for n in FMUS]:
+        needed |= wf.glibc_versions(path)
+    newest = max(needed)
+    if newest > wf.GLIBC_BASELINE:
+        sys.exit(f"the wheel's runner or FMUs need glibc {'.'.join(map(str, newest))}, above the baseline "
+                 f"{'.'.join(map(str, wf.GLIBC_BASELINE))}")
+    return wf.RUNNER_228, wf.FMU_DIR, ".".join(map(str, newest))
 
 
 class build_with_runner(build_py):
@@ -52,7 +58,7 @@ class build_with_runner(build_py):
         super().run()
         sys.path.insert(0, HERE)
         from wheelflat_study.buildinfo import collect
-        runner, fmu_dir = built()
+        runner, fmu_dir, glibc = built()
         data = os.path.join(self.build_lib, "wheelflat_study", "_data")
         os.makedirs(os.path.join(data, "bin"), exist_ok=True)
         os.makedirs(os.path.join(data, "fmu"), exist_ok=True)
@@ -63,6 +69,7 @@ class build_with_runner(build_py):
             shutil.copyfile(os.path.join(fmu_dir, name + ".fmu"), os.path.join(data, "fmu", name + ".fmu"))
         import json
         info = collect(dest, os.path.join(data, "fmu"), ROOT)
+        info["glibc_needed"] = glibc
         with open(os.path.join(data, "build.json"), "w") as fh:
             json.dump(info, fh, indent=1)
 

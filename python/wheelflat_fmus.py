@@ -1,6 +1,7 @@
 """Helpers for the wheelflat FMUs: a local virtual environment with fmpy, building the
-FMUs with cargo, and the coupling of TrackContact with RollPlaneVehicle through fmpy's
-FMU2Slave in the order of MODEL.md.
+FMUs (through scripts/build_fmus_glibc228.sh, for the glibc 2.28 baseline), and the
+coupling of TrackContact with RollPlaneVehicle through fmpy's FMU2Slave in the order of
+MODEL.md.
 
 The static-equilibrium handshake (in initialization mode):
   1. vehicle -> track: ``static_load.left``, ``static_load.right`` (N);
@@ -10,12 +11,15 @@ vehicle inputs -> both step.
 """
 
 import os
+import re
 import subprocess
 import sys
+import tempfile
 import venv
+import zipfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# In a checkout (python/ inside the repository) the FMUs are built with cargo into fmu/;
+# In a checkout (python/ inside the repository) the FMUs are built into fmu/;
 # installed from the wheelflat wheel (python/pyproject.toml) they come with it.
 CHECKOUT = os.path.isfile(os.path.join(ROOT, "Cargo.toml"))
 VENV = os.path.join(ROOT, ".venv")
@@ -25,6 +29,13 @@ FMU_DIR = os.path.join(ROOT, "fmu") if CHECKOUT else \
 FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
 # Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
+# The one build of the FMUs, shared by the README's main command (build_fmus below), the
+# test command and the wheel (python/setup.py): cargo-zigbuild against this glibc
+# baseline (docs/guide/fmus.md, "Where the FMUs run"). The case runner it builds beside
+# the library is RUNNER_228.
+BUILD_SCRIPT = os.path.join(ROOT, "scripts", "build_fmus_glibc228.sh")
+GLIBC_BASELINE = (2, 28)
+RUNNER_228 = os.path.join(TARGET_DIR, "x86_64-unknown-linux-gnu", "release", "wheelflat_case")
 
 
 def venv_python():
@@ -56,14 +67,28 @@ def ensure_venv():
 
 
 def build_fmus():
-    """Builds the shared library and packs fmu/*.fmu (cargo, release profile); the FMUs
-    by name. Installed from the wheel: the FMUs that came with it."""
+    """Builds the shared library against the glibc 2.28 baseline and packs fmu/*.fmu
+    through scripts/build_fmus_glibc228.sh (cargo-zigbuild, release profile; cargo's
+    progress on stderr, the packer's list dropped); the FMUs by name. Installed from the
+    wheel: the FMUs that came with it, built the same way."""
     if not CHECKOUT:
         return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
-    subprocess.check_call(["cargo", "build", "--release", "--quiet", "--lib", "--bin", "build_fmus"], cwd=ROOT)
-    subprocess.check_call([os.path.join(TARGET_DIR, "release", "build_fmus"), FMU_DIR], cwd=ROOT,
-                          stdout=subprocess.DEVNULL)
+    subprocess.check_call(["bash", BUILD_SCRIPT, FMU_DIR], cwd=ROOT, stdout=subprocess.DEVNULL)
     return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
+
+
+def glibc_versions(path):
+    """The glibc symbol versions, as tuples such as (2, 28), that the ELF file at `path`
+    needs (objdump -T); for an .fmu, those of every library under its binaries/."""
+    if path.endswith(".fmu"):
+        found = set()
+        with zipfile.ZipFile(path) as z, tempfile.TemporaryDirectory() as tmp:
+            for member in z.namelist():
+                if member.startswith("binaries/") and not member.endswith("/"):
+                    found |= glibc_versions(z.extract(member, tmp))
+        return found
+    dump = subprocess.run(["objdump", "-T", path], capture_output=True, text=True, check=True).stdout
+    return {tuple(int(x) for x in v.split(".")) for v in re.findall(r"\bGLIBC_([0-9]+(?:\.[0-9]+)*)", dump)}
 
 
 def value_references(model_description):

@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# Packs fmu/*.fmu with the shared library built against glibc 2.28 (RHEL 8, Debian 10's
-# 2.28, Ubuntu 20.04's 2.31 and later load it), by cargo-zigbuild (crates.io) with zig
-# (the PyPI package ziglang, in target/ziglang); then checks with objdump -T that no glibc symbol
-# version above 2.28 is needed. The normal `cargo build` and `build_fmus` are untouched.
+# The one build of the FMUs: the shared library, the packer (build_fmus) and the case
+# runner (wheelflat_case) built against the glibc 2.28 baseline (docs/guide/fmus.md,
+# "Where the FMUs run") by cargo-zigbuild with zig, both from PyPI (pinned below, into
+# target/ziglang); fmu/*.fmu, the C header and fmu/systems packed from that library;
+# then objdump -T checks that neither the library nor the runner needs a glibc symbol
+# version above 2.28. The README's main command (python/wheelflat_fmus.py, build_fmus),
+# the test command and the wheel (python/setup.py) all build through here. cargo's
+# progress goes to stderr, the packer's list to stdout.
 #   bash scripts/build_fmus_glibc228.sh [OUT_DIR]
 set -euo pipefail
 # A relative OUT_DIR is the caller's, resolved before moving to the repository.
@@ -10,19 +14,32 @@ out="${1:-$(dirname "$0")/../fmu}"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 cd "$(dirname "$0")/.."
-# zig in the build folder (not .venv, which the test command fills meanwhile).
-zig="${CARGO_TARGET_DIR:-target}/ziglang"
-[ -x "$zig/ziglang/zig" ] || python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$zig" "ziglang==0.17.1"
-export PATH="$(cd "$zig/ziglang" && pwd):$HOME/.cargo/bin:$PATH"
-command -v cargo-zigbuild >/dev/null || cargo install --locked -q cargo-zigbuild
-target=x86_64-unknown-linux-gnu
-cargo zigbuild --release --quiet --lib --target "$target.2.28"
-cargo build --release --quiet --bin build_fmus
-lib="${CARGO_TARGET_DIR:-target}/$target/release/libwheelflat.so"
-WHEELFLAT_FMU_LIBRARY="$lib" "${CARGO_TARGET_DIR:-target}/release/build_fmus" "$out"
-newest=$(objdump -T "$lib" | grep -o 'GLIBC_[0-9.]*' | sort -uV | tail -1)
-echo "newest glibc symbol version needed: $newest"
-if [ "$(printf '%s\n' "$newest" GLIBC_2.28 | sort -V | tail -1)" != GLIBC_2.28 ]; then
-    echo "error: $lib needs $newest, above the 2.28 baseline" >&2
-    exit 1
+# $CARGO_TARGET_DIR, when set, relative to the repository (as python/wheelflat_fmus.py reads it).
+target_dir="${CARGO_TARGET_DIR:-target}"
+baseline=2.28
+# zig and cargo-zigbuild in the build folder (not .venv, which the test command fills
+# meanwhile), installed again when the pins change.
+tools="$target_dir/ziglang"
+pins="cargo-zigbuild==0.24.0 ziglang==0.17.1"
+if [ "$(cat "$tools/pins" 2>/dev/null)" != "$pins" ]; then
+    echo "build_fmus_glibc228.sh: installing $pins (PyPI) into $tools" >&2
+    rm -rf "$tools"
+    # shellcheck disable=SC2086
+    python3 -m pip install -q --disable-pip-version-check --root-user-action=ignore --target "$tools" $pins
+    echo "$pins" >"$tools/pins"
 fi
+command -v objdump >/dev/null || { echo "error: objdump (binutils) is needed to check the glibc baseline" >&2; exit 1; }
+export PATH="$(cd "$tools/ziglang" && pwd):$(cd "$tools/bin" && pwd):$PATH"
+triple=x86_64-unknown-linux-gnu
+cargo zigbuild --release --lib --bin build_fmus --bin wheelflat_case --target "$triple.$baseline"
+built="$target_dir/$triple/release"
+# The packer packs the library beside it (target/x86_64-unknown-linux-gnu/release/).
+WHEELFLAT_FMU_LIBRARY="$built/libwheelflat.so" "$built/build_fmus" "$out"
+for f in "$built/libwheelflat.so" "$built/wheelflat_case"; do
+    newest=$(objdump -T "$f" | grep -o 'GLIBC_[0-9][0-9.]*' | sort -uV | tail -1)
+    echo "$f: newest glibc symbol version needed: $newest"
+    if [ "$(printf '%s\n' "$newest" "GLIBC_$baseline" | sort -V | tail -1)" != "GLIBC_$baseline" ]; then
+        echo "error: $f needs $newest, above the $baseline baseline" >&2
+        exit 1
+    fi
+done

@@ -25,11 +25,11 @@ cargo build --release
 cargo test --release --lib --bins --tests
 
 echo "   (${SECONDS} s so far)"
-echo "== FMUs: pack fmu/*.fmu and the C header, the library against the glibc 2.28 baseline"
-"${CARGO_TARGET_DIR:-target}/release/build_fmus" fmu
-# The FMUs the tests below load are the ones users get: built with cargo-zigbuild
-# against glibc 2.28 (objdump -T checked), while .venv (python/requirements.txt) is set
-# up beside it (pip works on one core, the build on both).
+echo "== FMUs: pack fmu/*.fmu, the C header and fmu/systems, the library against the glibc 2.28 baseline"
+# The one build of the FMUs, the README's main command's and the wheel's: cargo-zigbuild
+# against glibc 2.28 (objdump -T checked; tests/test_fmu_build.py checks what the main
+# command leaves), while .venv (python/requirements.txt) is set up beside it (pip works
+# on one core, the build on both).
 venv_log="$(mktemp)"
 python3 python/wheelflat_fmus.py >"$venv_log" 2>&1 &
 venv_setup=$!
@@ -50,10 +50,11 @@ fi
 python3 python/wheelflat_fmus.py
 # test_masters.py: the shipped fmu/systems/ in libcosim and ecos against CoupledSystem.
 # test_docs.py: the commands of README.md and docs/guide/ run (or matched to the test
-# that runs them) and the documentation's links. One process: test_docs.py's guide
-# scripts pack fmu/ again, which the others read (two pytest-xdist workers took 2.5 min
-# off, but one of five runs lost a study command to an abort at its exit, to be found).
-.venv/bin/python -m pytest -q tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
+# that runs them) and the documentation's links. One process: test_fmu_build.py's main
+# command and test_docs.py's guide scripts pack fmu/ again, which the others read (two
+# pytest-xdist workers took 2.5 min off, but one of five runs lost a study command to an
+# abort at its exit, to be found).
+.venv/bin/python -m pytest -q tests/test_fmu_build.py tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_numpy_track.py
 fmi_rc=0
 wait "$fmi_build" || fmi_rc=$?
 cat "$fmi_log"

@@ -12,7 +12,7 @@ Every relative link of README.md and docs/**/*.md must point to a file that exis
 an anchor into a Markdown file to one of its headings.
 
 Run by the README's test command, after the FMUs, fmu/systems and .venv are built. The
-scripts the guide shows repack fmu/ with the host build (``wheelflat_fmus.build_fmus``);
+scripts the guide shows pack fmu/ again (``wheelflat_fmus.build_fmus``, the same build);
 the FMUs the test command packed are put back afterwards.
 """
 
@@ -48,13 +48,10 @@ MAPPED = {
     "python3 python/wheelflat_fmus.py": (
         "scripts/test.sh", ["python3 python/wheelflat_fmus.py"],
         "sets up .venv, which this test runs in; the test command runs it before pytest"),
-    "cargo build --release && ./target/release/build_fmus fmu": (
-        "scripts/test.sh", ["cargo build --release\n", '/release/build_fmus" fmu\n'],
-        "the test command builds and packs the FMUs this test loads (and honours CARGO_TARGET_DIR, "
-        "where ./target does not); packing them again here would replace the glibc 2.28 build"),
     "bash scripts/build_fmus_glibc228.sh fmu": (
         "scripts/test.sh", ["bash scripts/build_fmus_glibc228.sh fmu\n"],
-        "a minute or more; the test command packs the FMUs every later test loads with it"),
+        "the one build of the FMUs, minutes from a clean clone; the test command packs the FMUs every "
+        "later test loads with it, and the main command that this test runs packs through it"),
     "python: vehicle.enterInitializationMode(); track.enterInitializationMode()": (
         "tests/test_fmu_coupling.py::test_static_handshake_puts_the_pair_at_rest", ["wf.run_pair("],
         "pseudo-code (value references by name) of wheelflat_fmus.static_handshake, which run_pair "
