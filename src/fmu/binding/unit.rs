@@ -299,7 +299,18 @@ impl Model for FmuModel {
                     self.published.step = dt;
                 }
                 let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
-                sim.advance_to(plan)?;
+                if let Err(mut e) = sim.advance_to(plan) {
+                    // A run beyond the health bounds that the input datum may explain
+                    // names it (issue 38, N5).
+                    let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
+                    if let (Error::Diverged { cause, .. }, Kind::TrackContact) = (&mut e, self.kind)
+                        && let Some(d) = self.datum.explain(axle_box)
+                    {
+                        cause.push_str("; ");
+                        cause.push_str(&d);
+                    }
+                    return Err(e.into());
+                }
                 // The master's step (its clock, not the track's grid).
                 self.last_step = end - self.master_end;
                 self.master_end = end;

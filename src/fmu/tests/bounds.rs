@@ -152,6 +152,39 @@ fn wheel_inputs_far_into_the_rail_stop_the_run_with_an_error() {
 }
 
 #[test]
+fn a_force_beyond_the_bound_that_the_input_datum_explains_names_it() {
+    // Issue 38 (N5): a first step on heights of 0 was taken as the static state, and
+    // the failure a few steps later blamed only the wheel inputs.
+    let (mut i, _) = instance(Kind::TrackContact);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    let h = real(&mut i, vr::SOLVER_STEP);
+    let z = |i: &mut Instance, x: f64| {
+        i.set_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z], &[x, x])
+            .unwrap()
+    };
+    z(&mut i, 0.0);
+    i.do_step(0.0, h).unwrap();
+    // A move of less than half the static deflection: no new datum.
+    z(&mut i, -0.7e-3);
+    i.do_step(h, h).unwrap();
+    z(&mut i, -8e-3);
+    let mut p = [0.0];
+    let e = i.get_real(&[vr::CONTACT_LEFT_FORCE], &mut p).unwrap_err();
+    let e2 = i.do_step(2.0 * h, h).unwrap_err();
+    for m in [&e.message, &e2.message] {
+        for part in [
+            "wheel inputs",
+            "inputs.datum = first_step",
+            "wheel.left.z was 0.0000 mm at the first step, taken for its static -1.5336 mm",
+            "inputs.datum = absolute",
+        ] {
+            assert!(m.contains(part), "{part}: {m}");
+        }
+    }
+}
+
+#[test]
 fn track_spans_set_on_the_endless_default_is_named_at_initialisation() {
     // Issue 29's breaker: a script written for the old default (the fixed track) that
     // sets track.spans ran the 10 m window silently.
