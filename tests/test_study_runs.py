@@ -105,6 +105,120 @@ def test_an_interrupted_study_resumes_with_the_cases_it_lacks(study, tmp_path, r
     assert comparable(resumed).equals(comparable(whole))
 
 
+# A perfect wheel at 15 or 20 m/s from 7.8 m: 0.06 s takes it into a dip between 8 and 9 m.
+DIPPED = """
+name = "{name}"
+duration = 0.06
+[fixed]
+start_position = 7.8
+"flat.left[1].depth" = 0.0
+"flat.left[1].length" = 0.0
+"rail.left.profile" = "{profile}"
+[sweep]
+speed = {speeds}
+"""
+# The client's table and the one a worker would find at the same path.
+CLIENTS = "# position (m)  height (m)\n0 0\n8 0\n8.5 -2e-3\n9 0\n30 0\n"
+WORKERS = "# position (m)  height (m)\n0 0\n8 0\n8.5 -0.5e-3\n9 0\n30 0\n"
+
+
+def _inline(table):
+    return "; ".join(line for line in table.splitlines() if not line.startswith("#"))
+
+
+def test_the_workers_run_the_table_the_client_read_never_a_file_at_its_path(tmp_path, runner):
+    # Issue 38 (N1): a table named by its path was read by each worker from its own
+    # file at that path; a cluster whose workers saw another file there gave "3 of 3
+    # cases, 0 failed", exit 0, with the workers' numbers. Here the client reads its
+    # file when it loads the study; then the file at that path is replaced before the
+    # cluster starts, so every worker would find the other table there. The numbers
+    # must be those of the client's table written out, never the other's.
+    profile = tmp_path / "profile.txt"
+    profile.write_text(CLIENTS)
+    p = tmp_path / "dip.toml"
+    p.write_text(DIPPED.format(name="dip", profile="profile.txt", speeds="[15.0, 20.0]"))
+    s = load_study(p)
+    profile.write_text(WORKERS)
+    on_dask, n = run_study(s, str(tmp_path / "dask"), workers=2, chunk=1, runner_path=runner, progress=False,
+                           plots=False, log=lambda *_: None)
+    assert n == 2 and (on_dask["status"] == "ok").all()
+    # The same cases with each table written out in the study file, run serially.
+    runs = {}
+    for name, table in (("clients", CLIENTS), ("workers", WORKERS)):
+        q = tmp_path / f"{name}.toml"
+        q.write_text(DIPPED.format(name=name, profile=_inline(table), speeds="[15.0, 20.0]"))
+        runs[name], _ = run_study(load_study(q), str(tmp_path / name), serial=True, runner_path=runner,
+                                  progress=False, plots=False, log=lambda *_: None)
+    numbers = [c for c in comparable(on_dask).columns if c.startswith(("peak.", "impacts.", "bearing.", "contact_"))]
+    assert numbers and comparable(on_dask)[numbers].equals(comparable(runs["clients"])[numbers])
+    # Not vacuous: the workers' file gives other numbers (the shallower dip).
+    assert (on_dask["peak.left"] > runs["workers"]["peak.left"] + 10e3).all()
+    # The table's name beside the hash of its content: the same content, the same case.
+    assert list(on_dask["rail.left.profile"]) == [str(profile)] * 2
+    assert list(on_dask["rail.left.profile.sha256"]) == list(runs["clients"]["rail.left.profile.sha256"])
+    assert list(on_dask["case_id"]) == list(runs["clients"]["case_id"])
+    assert list(on_dask["rail.left.profile.sha256"]) != list(runs["workers"]["rail.left.profile.sha256"])
+    import hashlib
+    assert on_dask["rail.left.profile.sha256"][0] == hashlib.sha256(b"0,0;8,0;8.5,-2e-3;9,0;30,0;").hexdigest()
+
+
+def test_a_resumed_study_runs_again_a_case_whose_table_file_was_edited(tmp_path, runner):
+    # Issue 38 (N2): a case's id covered the table's path, not its content: a study
+    # resumed after its file was edited reused the old results ("1 already done").
+    profile = tmp_path / "profile.txt"
+    profile.write_text(CLIENTS)
+    p = tmp_path / "dip.toml"
+    p.write_text(DIPPED.format(name="dip", profile="profile.txt", speeds="[20.0]"))
+    out = str(tmp_path / "o")
+    quiet = dict(serial=True, runner_path=runner, progress=False, plots=False)
+    first, _ = run_study(load_study(p), out, log=lambda *_: None, **quiet)
+    profile.write_text(WORKERS)
+    said = []
+    edited, n = run_study(load_study(p), out, log=said.append, **quiet)
+    assert n == 1 and "dip: 1 cases, 0 already done, 1 to run" in said, said
+    q = tmp_path / "inline.toml"
+    q.write_text(DIPPED.format(name="inline", profile=_inline(WORKERS), speeds="[20.0]"))
+    inline, _ = run_study(load_study(q), str(tmp_path / "inline"), log=lambda *_: None, **quiet)
+    assert edited["peak.left"][0] == inline["peak.left"][0] != first["peak.left"][0]
+    assert edited["rail.left.profile.sha256"][0] == inline["rail.left.profile.sha256"][0]
+    # The file as it was: its results are still there.
+    profile.write_text(CLIENTS)
+    said = []
+    again, n = run_study(load_study(p), out, log=said.append, **quiet)
+    assert n == 0 and "dip: 1 cases, 1 already done, 0 to run" in said, said
+    assert again["peak.left"][0] == first["peak.left"][0]
+
+
+LOSING_RUNNER = """\
+for line in sys.stdin:
+    if "speed=30" in line:
+        sys.exit(9)   # a runner killed on this case: no answer
+    child.stdin.write(line)
+    child.stdin.flush()
+    sys.stdout.write(child.stdout.readline())
+    sys.stdout.flush()
+"""
+
+
+def test_on_dask_a_lost_case_runs_again_in_the_same_run_then_fails_by_name(tmp_path, runner):
+    # Issue 38 (N14): on Dask as in one process (test_study_cases.py): a case whose
+    # runner stops runs again at once, three times in all, then is failed by name.
+    import json
+    losing = tmp_path / "losing_runner"
+    fake_runner(losing, runner, LOSING_RUNNER)
+    p = tmp_path / "lost.toml"
+    p.write_text('name = "lost"\nduration = 0.01\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
+    said = []
+    table, n = run_study(load_study(p), str(tmp_path / "o"), workers=1, chunk=1, runner_path=str(losing),
+                         progress=False, plots=False, log=said.append)
+    assert n == 3 and list(table["status"]) == ["ok", "error", "ok"], table
+    assert table["error"][1].startswith("lost 3 times in one run") and "exit status 9" in table["error"][1]
+    assert run_study.counts == {"ok": 2, "failed": 1, "lost": 1, "again": 2}
+    assert any("2 finished, 1 failed (1 of them lost 3 times" in x for x in said), said
+    lost = [json.loads(line) for line in open(tmp_path / "o" / "cases.jsonl") if '"speed": 30.0' in line]
+    assert [bool(rec["result"].get("transient")) for rec in lost] == [True, True, False]
+
+
 MILLION = """
 name = "million"
 duration = 0.001

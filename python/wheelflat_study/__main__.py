@@ -16,8 +16,7 @@ import sys
 
 from .run import (MAX_TIME_LIMIT, MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study,
                   stop_runners)
-from .spec import MAX_CASES
-from .spec import load_study
+from .spec import MAX_CASES, Table, load_study
 
 
 def main(argv=None):
@@ -188,14 +187,13 @@ def check_variables(study, runner):
             raise ValueError(f"`{name}` is not a parameter or input of CoupledSystem (docs/VARIABLES.md)")
         ty, lo, hi = known[name]
         for v in vs:
-            if (ty == "String") != isinstance(v, str):
-                raise ValueError(f"`{name}` = {v!r}: " + ("a table's path or the table itself (x,y;x,y;...)"
+            # A table was read when the study was loaded (spec.read_table); a number
+            # written as text was left as text, to be refused here.
+            if (ty == "String") != isinstance(v, Table):
+                raise ValueError(f"`{name}` = {v!r}: " + ("a table: its file's path, the table itself "
+                                                          "(x y; x y; ...), or \"\" for no table"
                                                           if ty == "String" else "a number"))
             if ty == "String":
-                from .spec import inline
-                if not inline(v) and not os.path.isfile(v):
-                    raise ValueError(f"`{name}` = {v!r}: no such file (a relative path is taken from "
-                                     f"the study file's folder)")
                 continue
             if not lo <= v <= hi:
                 raise ValueError(f"`{name}` = {v:g} is out of range: {lo:g} <= {name} <= {hi:g}")

@@ -28,6 +28,10 @@ RUNNER = os.path.join(TARGET_DIR, "release", "wheelflat_case")
 # times the default's cost) on four wheelsets with the machine 1.7 times slower.
 TIME_LIMIT_FACTOR = 200.0
 MIN_TIME_LIMIT = 60.0
+# A case whose runner stops, whose worker is lost or whose answer is for another case
+# runs again within the same run, at most this many times in all; then it is recorded
+# as failed, by name ("lost N times ..."; --retry-failed runs it again).
+MAX_TRIES = 3
 
 
 def installed():
@@ -198,15 +202,18 @@ def identity(runner_path=None):
 
 
 def run_chunk(chunk, runner_path=None):
-    """Runs the cases of `chunk` (a list of (case id, runner line, time limit s)) in
-    this thread's runner; (the runner's identity (version, GUID, engine), where it ran
-    (the Dask worker's address, or None), a list of (case id, result dict, wall seconds
-    in this function)). The identity lets the study keep only results of its own model,
+    """Runs the cases of `chunk` (a list of (case id, runner line, time limit s); a line
+    may be a list of pieces to join, Case.parts, which shares a table's content between
+    the cases of a chunk) in this thread's runner; (the runner's identity (version,
+    GUID, engine), where it ran (the Dask worker's address, or None), a list of (case
+    id, result dict, wall seconds in this function)). The identity lets the study keep only results of its own model,
     also from workers that joined after it started."""
     out = []
     ident = identity(runner_path)
     r = _runner(runner_path)
     for cid, line, limit in chunk:
+        if not isinstance(line, str):
+            line = "".join(line)
         t0 = time.perf_counter()
         try:
             res = r.run(line, cid, limit)
@@ -354,16 +361,17 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
         def limit(case):
             return time_limit
     ready = time.perf_counter()
+    counts = run_study.counts = {"ok": 0, "failed": 0, "lost": 0, "again": 0}
     if total > have:
         if serial:
-            _serial(todo, total - have, out_dir, runner_path, progress, limit)
+            _serial(todo, total - have, out_dir, runner_path, progress, limit, counts)
         else:
             ready = _dask(todo, total - have, out_dir, runner_path, scheduler, workers, chunk, progress, limit,
-                          ident)
+                          ident, counts)
     finished = time.perf_counter()
     elapsed = finished - ready
     if total > have:
-        log(f"ran {total - have} cases in {elapsed:.2f} s ({60 * (total - have) / elapsed:.0f} cases per minute)")
+        log(_ran(counts, total - have, elapsed))
     from .tables import write_tables
     table = write_tables(study, out_dir, ident)
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
@@ -372,14 +380,52 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
         from .plots import make_plots
         for p in make_plots(study, table, out_dir, log):
             log(f"wrote {p}")
-    return table, total - have
+    return table, counts["ok"] + counts["failed"]
+
+
+def _ran(counts, count, elapsed):
+    """What ran, in words: the cases that finished (a result, or a failure of the case
+    itself), those that failed, those lost MAX_TRIES times (failed by name), the runs
+    lost and run again, and any case left without a result."""
+    ran = counts["ok"] + counts["failed"]
+    text = f"ran {ran} cases in {elapsed:.2f} s ({60 * ran / max(elapsed, 1e-9):.0f} cases per minute): " \
+           f"{counts['ok']} finished, {counts['failed']} failed"
+    if counts["lost"]:
+        text += f" ({counts['lost']} of them lost {MAX_TRIES} times: a runner or worker stopped on each try)"
+    if counts["again"]:
+        text += f"; {counts['again']} runs lost (a runner or worker stopped) and run again"
+    if count > ran:
+        text += f"; {count - ran} without a result"
+    return text
+
+
+def _final(res, tries, counts):
+    """The result to record of a case's try number `tries` (from 1), or None when it
+    was lost (a stopped runner or worker, an answer for another case) and runs again;
+    counts it."""
+    if res.get("transient"):
+        if tries < MAX_TRIES:
+            counts["again"] += 1
+            return None
+        # Lost on every try: a failure by name, not a case left without a result.
+        res = {"error": f"lost {tries} times in one run (each try's runner or worker stopped; the last: "
+                        f"{res.get('error')}): the case may stop its runner; --retry-failed runs it again",
+               "lost": tries}
+        counts["lost"] += 1
+    counts["failed" if res.get("error") else "ok"] += 1
+    return res
 
 
 def _record(cid, res, wall, case, ident):
     """A line of cases.jsonl; `ident`: the (version, GUID, engine) of the runner that
-    answered."""
-    return {"id": cid, "params": case.params, "duration": case.duration, "keep": list(case.keep),
-            "result": res, "wall_s": wall, "identity": list(ident)}
+    answered. A table parameter is kept by its name, and in `tables` the hash of the
+    content the case ran with."""
+    rec = {"id": cid, "params": case.record_params(), "duration": case.duration, "keep": list(case.keep),
+           "result": res, "wall_s": wall, "identity": list(ident)}
+    tables = case.table_hashes()
+    if tables:
+        rec["tables"] = tables
+    return rec
 
 
 def _bar(total, progress):
@@ -389,21 +435,28 @@ def _bar(total, progress):
     return tqdm(total=total, unit="case", file=sys.stderr)
 
 
-def _serial(todo, count, out_dir, runner_path, progress, limit):
-    """Runs the `count` cases of the iterator `todo` here, in order."""
+def _serial(todo, count, out_dir, runner_path, progress, limit, counts):
+    """Runs the `count` cases of the iterator `todo` here, in order (a lost case again
+    at once, up to MAX_TRIES times)."""
     bar = _bar(count, progress)
     for case in todo:
-        ident, _, [(cid, res, wall)] = run_chunk([(case.id, case.line(), limit(case))], runner_path)
-        _append(out_dir, [_record(cid, res, wall, case, ident)])
+        for tries in range(1, MAX_TRIES + 1):
+            ident, _, [(cid, res, wall)] = run_chunk([(case.id, case.parts(), limit(case))], runner_path)
+            final = _final(res, tries, counts)
+            # A lost try is recorded too (an interruption now runs it next time).
+            _append(out_dir, [_record(cid, final or res, wall, case, ident)])
+            if final is not None:
+                break
         if bar:
             bar.update(1)
     if bar:
         bar.close()
 
 
-def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress, limit, ident):
+def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress, limit, ident, counts):
     """Runs the `count` cases of the iterator `todo` on Dask, a few chunks per worker in
-    flight; returns when every worker's runner was ready (perf_counter)."""
+    flight (a lost case again, up to MAX_TRIES times in all); returns when every
+    worker's runner was ready (perf_counter)."""
     from dask.distributed import Client, LocalCluster, as_completed
     if scheduler:
         try:
@@ -445,18 +498,26 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
         flying = {}
 
         requeued = []
+        # The tries of the cases lost so far (only those: the dict stays small).
+        tries = {}
 
         def send():
             cases = [requeued.pop() for _ in range(min(size, len(requeued)))]
             cases += list(itertools.islice(todo, size - len(cases)))
             if cases:
-                fut = client.submit(run_chunk, [(c.id, c.line(), limit(c)) for c in cases], runner_path,
+                fut = client.submit(run_chunk, [(c.id, c.parts(), limit(c)) for c in cases], runner_path,
                                     pure=False)
                 flying[fut.key] = cases
                 pending.add(fut)
+            return bool(cases)
 
-        for _ in range(4 * nworkers):
-            send()
+        def fill():
+            # Four chunks a worker in flight, and every case sent again (several may
+            # come back from one chunk) on its way.
+            while (len(flying) < 4 * nworkers or requeued) and send():
+                pass
+
+        fill()
         bar = _bar(count, progress)
         retired, succeeded, failures = set(), False, []
         for fut in pending:
@@ -490,11 +551,21 @@ def _dask(todo, count, out_dir, runner_path, scheduler, workers, chunk, progress
                         pass
                 wid = ident
             fut.release()
-            if results:
-                _append(out_dir, [_record(cid, res, wall, cases[cid], wid) for cid, res, wall in results])
-            send()
+            records, finished = [], 0
+            for cid, res, wall in results:
+                tries[cid] = tries.get(cid, 0) + 1
+                final = _final(res, tries[cid], counts)
+                if final is None:
+                    requeued.append(cases[cid])
+                else:
+                    tries.pop(cid)
+                    finished += 1
+                records.append(_record(cid, final or res, wall, cases[cid], wid))
+            if records:
+                _append(out_dir, records)
+            fill()
             if bar:
-                bar.update(len(results))
+                bar.update(finished)
         if bar:
             bar.close()
         return ready

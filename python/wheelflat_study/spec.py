@@ -7,6 +7,8 @@ import math
 import os
 import random
 import re
+import stat
+import sys
 import tomllib
 from dataclasses import dataclass, field
 
@@ -24,6 +26,41 @@ UNITS = {None: 1.0, "": 1.0, "km/h": 1 / 3.6, "mm": 1e-3, "deg": math.pi / 180, 
          "MN/m": 1e6, "kN.s/m": 1e3}
 
 
+# A table's file: at most this many bytes (the engine's MAX_TABLE_FILE) and points
+# (its MAX_TABLE_POINTS).
+MAX_TABLE_FILE = 100_000_000
+MAX_TABLE_POINTS = 1_000_000
+# A number as the engine reads it (Rust's f64 from text): a table's point is two.
+_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",
+                     re.IGNORECASE)
+_BLANKS = re.compile(r"[\s,]+")
+
+
+@dataclass(frozen=True)
+class Table:
+    """A String parameter's table as this process read it, once, when the study was
+    loaded: ``name`` (the file's path, or the table as written out; "" for no table),
+    ``text`` (the points as the engine takes a table written out, ``x,y;x,y;...;``,
+    without blanks or comments; "" for no table) and ``sha256`` (of ``text``, in hex;
+    "" for no table). The workers get ``text``, never the path: a worker never reads
+    a file, and a case's id holds the hash, so an edited file is a new case."""
+    name: str
+    text: str
+    sha256: str
+
+    def __repr__(self):
+        # Never the content of a file (a refusal may quote a value).
+        return repr(self.name) if self.name else "'' (no table)"
+
+    @property
+    def key(self):
+        """The table in a case's id: its content's hash."""
+        return "sha256:" + self.sha256 if self.text else "no table"
+
+
+NO_TABLE = Table("", "", "")
+
+
 @dataclass
 class Case:
     """One run: the variables set (name -> SI value), in the study's order."""
@@ -36,7 +73,8 @@ class Case:
     def id(self):
         """A stable identity of the case: what it sets, for how long, what it keeps
         (16 hex digits of the SHA-1 of ``json.dumps([sorted (name, repr(value)) pairs,
-        repr(duration), keep])``)."""
+        repr(duration), keep])``; a table's value is ``"sha256:"`` and its content's
+        hash, so an edited file makes another case, a renamed one the same)."""
         if self._id is None:
             text = json.dumps([sorted((k, _repr(v)) for k, v in self.params.items()),
                                repr(float(self.duration)), list(self.keep)])
@@ -45,11 +83,36 @@ class Case:
 
     def line(self):
         """The case as the runner reads it."""
-        toks = [f"{k}={v}" if isinstance(v, str) else f"{k}={float(v)!r}" for k, v in self.params.items()]
-        toks.append(f"duration={float(self.duration)!r}")
+        return "".join(self.parts())
+
+    def parts(self):
+        """The case's line in pieces whose concatenation is :meth:`line`: a table's
+        content (never its path) is a piece of its own, the study's own string, so the
+        cases of a Dask chunk that share a table carry it once (pickle keeps one copy
+        of an object within a message)."""
+        parts = []
+        text = []
+        for k, v in self.params.items():
+            if isinstance(v, Table):
+                text.append(f"{k}=")
+                parts += [" ".join(text), v.text]
+                text = [""]
+            else:
+                text.append(f"{k}={v}" if isinstance(v, str) else f"{k}={float(v)!r}")
+        text.append(f"duration={float(self.duration)!r}")
         if self.keep:
-            toks.append("keep=" + ",".join(self.keep))
-        return " ".join(toks)
+            text.append("keep=" + ",".join(self.keep))
+        parts.append(" ".join(text))
+        return parts
+
+    def record_params(self):
+        """The parameters as a record of cases.jsonl keeps them: a table by its name
+        (its hash is in ``tables``)."""
+        return {k: v.name if isinstance(v, Table) else v for k, v in self.params.items()}
+
+    def table_hashes(self):
+        """The tables' hashes by parameter (sha256 of the content the case ran)."""
+        return {k: v.sha256 for k, v in self.params.items() if isinstance(v, Table)}
 
 
 @dataclass
@@ -62,6 +125,14 @@ class Study:
     keep: tuple = ()
     plots: list = field(default_factory=list)
     display: dict = field(default_factory=dict)  # name -> (unit, factor to the unit)
+
+    def __post_init__(self):
+        # A study made in code, with a table's path or the table as text: read here,
+        # once (a relative path from the working folder), as load_study does.
+        base, cache = os.getcwd(), {}
+        self.fixed = {k: _tables(k, [v], base, cache)[0] if isinstance(v, str) else v for k, v in self.fixed.items()}
+        self.sweep = {k: _tables(k, v, base, cache) if any(isinstance(x, str) for x in v) else v
+                      for k, v in self.sweep.items()}
 
     def count(self):
         """The number of cases."""
@@ -87,10 +158,10 @@ class Study:
                 lens = ", ".join(f"{k}: {len(v)}" for k, v in self.sweep.items())
                 raise ValueError(f"combine = zip needs every swept variable to have as many values ({lens})")
             # Rows differ when one variable's values all differ; else compare the rows.
-            if lists and not any(len(set(map(repr, v))) == len(v) for v in lists):
+            if lists and not any(len(set(map(_repr, v))) == len(v) for v in lists):
                 seen = set()
                 for row in zip(*lists):
-                    key = tuple(map(repr, row))
+                    key = tuple(map(_repr, row))
                     if key in seen:
                         raise ValueError(f"the study has the same case twice: {dict(zip(names, row))} "
                                          f"(repeated values in the sweep)")
@@ -100,11 +171,11 @@ class Study:
         for i, v in enumerate(lists):
             seen = set()
             for x in v:
-                if repr(x) in seen:
+                if _repr(x) in seen:
                     row = dict(zip(names, (w[0] for w in lists)))
                     row[names[i]] = x
                     raise ValueError(f"the study has the same case twice: {row} (repeated values in the sweep)")
-                seen.add(repr(x))
+                seen.add(_repr(x))
 
     def iter_cases(self):
         """The cases one by one, in the study's order, each with its id (made here at
@@ -117,11 +188,13 @@ class Study:
         fixed = {k: _repr(v) for k, v in self.fixed.items()}
         keep = tuple(self.keep)
         sha1 = hashlib.sha1
+        # A float's text is its repr; a table's, its content's hash (_repr).
+        text_of = _repr if any(isinstance(x, Table) for v in self.sweep.values() for x in v) else repr
         for row in self._rows():
             params = dict(self.fixed)
             params.update(zip(names, row))
             text = dict(fixed)
-            text.update(zip(names, map(repr, row)))
+            text.update(zip(names, map(text_of, row)))
             pairs = '"], '.join(head[k] + text[k] for k in order) + '"]' if order else ""
             idtext = "[[" + pairs + rest
             yield Case(params, self.duration, keep, sha1(idtext.encode()).hexdigest()[:16])
@@ -134,7 +207,11 @@ class Study:
 
 
 def _repr(v):
-    """A value's text in a case's id: a number's float repr, a table's own repr."""
+    """A value's text in a case's id: a number's float repr, a table's content's hash
+    (a text left as it is, a number written as text that is refused before anything
+    runs, its own repr)."""
+    if isinstance(v, Table):
+        return repr(v.key)
     return repr(v) if isinstance(v, str) else repr(float(v))
 
 
@@ -152,28 +229,119 @@ def _is_number(v):
         return False
 
 
-def _path_from(base, v):
-    """A table's path `v` taken from the folder `base` when relative; other values (and
-    text that reads as a number, which is refused later as a String for a number) as
-    they are."""
-    if isinstance(v, str) and not inline(v) and not os.path.isabs(v) and not _is_number(v):
-        return os.path.normpath(os.path.join(base, v))
-    return v
+def read_table(name, v, base, cache=None):
+    """The String parameter `name`'s value `v` as a :class:`Table`, read once, here:
+    "" (or blanks) for no table; a value that holds a `;` or a line break is the table
+    itself; any other is a table file's path (taken from the folder `base` when
+    relative), which must be a regular file of at most MAX_TABLE_FILE bytes of UTF-8
+    text (a byte-order mark is skipped). Either way the points are read as the engine
+    reads a table (``Table::parse``: one point a line or between `;`, two numbers
+    separated by blanks or a comma, text after `#` a comment) and written out as
+    ``x,y;x,y;...;``. A refusal names the variable, the value and what is allowed, and
+    never quotes the file's content. `cache`: a dict of the files read so far (by
+    path), so a file named twice is read once."""
+    where = f"`{name}` = {v!r}"
+    if not v.strip():
+        return NO_TABLE
+    if inline(v):
+        return _table(f"`{name}` (the table written out)", None, v)
+    path = os.path.normpath(os.path.join(base, v.strip()))
+    if cache is not None and path in cache:
+        return cache[path]
+    allowed = (f"a table's file (a regular file of at most {MAX_TABLE_FILE:,} bytes of UTF-8 text, two numbers "
+               f"a line), its path absolute or relative to the study file's folder; or the table itself "
+               f"(x y; x y; ...); or \"\" for no table")
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ValueError(f"{where}: not a table: no file at {path}, and not a table written out (it holds no "
+                         f"`;` or line break); allowed: {allowed}") from None
+    except OSError as e:
+        raise ValueError(f"{where}: cannot read {path} ({e.strerror}); allowed: {allowed}") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode)
+                or stat.S_ISBLK(st.st_mode) else "a pipe" if stat.S_ISFIFO(st.st_mode) else "a socket"
+                if stat.S_ISSOCK(st.st_mode) else "not a file")
+        raise ValueError(f"{where}: {path} is not a regular file ({kind}); allowed: {allowed}")
+    try:
+        # At most one byte past the limit: a file that grows (or gives no size, as
+        # /proc's do) is never read whole into memory.
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_TABLE_FILE + 1)
+    except OSError as e:
+        raise ValueError(f"{where}: cannot read {path} ({e.strerror}); allowed: {allowed}") from None
+    if len(data) > MAX_TABLE_FILE:
+        raise ValueError(f"{where}: {path} has more than {MAX_TABLE_FILE:,} bytes; allowed: {allowed}")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise ValueError(f"{where}: {path} is not UTF-8 text (byte {e.start + 1}); allowed: {allowed}") from None
+    table = _table(f"`{name}` ({path})", path, text)
+    if cache is not None:
+        cache[path] = table
+    return table
 
 
-def _text(where, v):
-    """A String parameter's value: a table's path, or the table as x,y;x,y;... (the
-    runner's case line splits at blanks, so the value holds none)."""
-    if not v or any(c.isspace() for c in v):
-        raise ValueError(f"{where}: `{v}`: give a table's path without blanks, or the table "
-                         f"itself as x,y;x,y;... without blanks")
-    return v
+def _table(where, name, text):
+    """The :class:`Table` named `name` (None: the content, for a table written out) of
+    the text `text` (the engine's table format; `where` names it in a refusal, which
+    quotes no content)."""
+    import numpy as np
+    if "\n" not in text and "#" in text:
+        raise ValueError(f"{where}: a `#` in a table on one line would make the rest of the line, points and "
+                         f"all, a comment: take the comment out, or give the table a line a point")
+    points = []
+    for n, line in enumerate(text.split("\n")):
+        line = line.split("#", 1)[0]
+        for k, point in enumerate(line.split(";")):
+            fields = [f for f in _BLANKS.split(point) if f]
+            if not fields:
+                continue
+            if len(fields) != 2 or not (_NUMBER.fullmatch(fields[0]) and _NUMBER.fullmatch(fields[1])):
+                part = f", its point {k + 1} after a `;`" if k else ""
+                raise ValueError(f"{where}: line {n + 1}{part}: not two numbers ({len(fields)} fields); allowed: "
+                                 f"x y, two numbers separated by blanks or a comma, a `;` or a line break "
+                                 f"between points, text after `#` a comment")
+            points.append(fields)
+            if len(points) > MAX_TABLE_POINTS:
+                raise ValueError(f"{where}: more than {MAX_TABLE_POINTS:,} points; allowed: 2 to "
+                                 f"{MAX_TABLE_POINTS:,}")
+    if len(points) < 2:
+        raise ValueError(f"{where}: {len(points)} points; allowed: 2 to {MAX_TABLE_POINTS:,} points, two numbers "
+                         f"each (\"\" for no table)")
+    xy = np.array(points, dtype=float)
+    bad = ~np.isfinite(xy).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(f"{where}, point {i + 1}: not finite; allowed: finite numbers")
+    steps = np.diff(xy[:, 0])
+    if (steps <= 0).any():
+        i = int(np.argmax(steps <= 0)) + 1
+        raise ValueError(f"{where}, point {i + 1}: x = {xy[i, 0]:.17g}; allowed: above the point before's "
+                         f"{xy[i - 1, 0]:.17g} (x strictly increasing)")
+    content = ";".join(a + "," + b for a, b in points) + ";"
+    return Table(content if name is None else name, content, hashlib.sha256(content.encode()).hexdigest())
+
+
+def _tables(name, values, base, cache):
+    """`values` with each text that is not a number read as a table (a number written
+    as text stays text: it is refused before anything runs, as a number for a table or
+    text for a number)."""
+    return [read_table(name, v, base, cache) if isinstance(v, str) and not _is_number(v) else v for v in values]
 
 
 def _number(where, v):
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ValueError(f"{where}: `{v}` is not a finite number")
-    return float(v)
+    try:
+        x = float(v)
+    except OverflowError:
+        # An integer of more than 308 digits (TOML has no limit).
+        raise ValueError(f"{where}: an integer of {len(str(abs(v)))} digits is not a finite number; allowed: "
+                         f"-1.8e308 to 1.8e308 (and the variable's own range)") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{where}: `{v}` is not a finite number")
+    return x
 
 
 def _unit(where, unit):
@@ -237,7 +405,7 @@ def _values(name, entry):
     if unit and any(isinstance(v, str) for v in values):
         raise ValueError(f"{where}: unit = {unit!r} with text values (tables): a unit is for numbers")
     # + 0.0 makes -0.0 the 0.0 it is (else the same physics ran as two cases).
-    return [_text(where, v) if isinstance(v, str) else _number(where, v) * f + 0.0 for v in values], unit
+    return [v if isinstance(v, str) else _number(where, v) * f + 0.0 for v in values], unit
 
 
 def load_study(path):
@@ -245,7 +413,7 @@ def load_study(path):
     with open(path, "rb") as fh:
         try:
             d = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as e:
+        except ValueError as e:  # TOMLDecodeError, an integer over Python's 4300 digits
             raise ValueError(f"not valid TOML: {e}") from None
     extra = set(d) - TOP_KEYS
     if extra:
@@ -271,19 +439,21 @@ def load_study(path):
             unit = _unit(f"fixed `{var}`", entry.get("unit"))
             fixed[var] = _number(f"fixed `{var}`", entry["value"]) * UNITS[unit]
         elif isinstance(entry, str):
-            fixed[var] = _text(f"fixed `{var}`", entry)
+            fixed[var] = entry
         else:
             fixed[var] = _number(f"fixed `{var}`", entry) + 0.0
-    # A table's relative path is the study file's: the runners may run elsewhere.
+    # Every table is read here, once (a relative path from the study file's folder):
+    # the workers get the content.
     base = os.path.dirname(os.path.abspath(path))
+    cache = {}
     for var, v in fixed.items():
-        fixed[var] = _path_from(base, v)
+        [fixed[var]] = _tables(var, [v], base, cache)
     sweep = {}
     for var, entry in d.get("sweep", {}).items():
         if var in fixed:
             raise ValueError(f"`{var}` is both fixed and swept")
         sweep[var], unit = _values(var, entry)
-        sweep[var] = [_path_from(base, v) for v in sweep[var]]
+        sweep[var] = _tables(var, sweep[var], base, cache)
         if unit:
             display[var] = (unit, 1 / UNITS[unit])
     combine = d.get("combine", "product")
@@ -313,7 +483,7 @@ def load_study(path):
             if key in p and not isinstance(p[key], str):
                 raise ValueError(f"plot {i + 1}: {key} = {p[key]!r}: a column name or text, in quotes")
         if "scale" in p and not (isinstance(p["scale"], (int, float)) and not isinstance(p["scale"], bool)
-                                 and math.isfinite(p["scale"]) and p["scale"] != 0):
+                                 and abs(p["scale"]) <= sys.float_info.max and p["scale"] != 0):
             raise ValueError(f"plot {i + 1}: scale = {p['scale']!r}: a finite number other than 0")
     study = Study(name=name, duration=duration, fixed=fixed, sweep=sweep, combine=combine,
                   keep=tuple(keep), plots=plots, display=display)

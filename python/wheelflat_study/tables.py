@@ -5,6 +5,8 @@ CSV, in the order of the study's cases."""
 import json
 import os
 
+from .spec import Table
+
 # Columns that describe how a case ran, not what it gave: left out of comparisons.
 TIMING = ("wall_s", "runner_wall_s")
 
@@ -39,11 +41,26 @@ TEXT = ("case_id", "status", "error", "warnings", "version", "guid", "engine", "
 BATCH = 20_000
 
 
+def _params(case):
+    """A case's parameters as columns: a table by its name (its file's path, or the table
+    written out; "" for none) and, in the column beside it, `NAME.sha256`, the hash of
+    the content the case ran with ("" for none)."""
+    row = {}
+    for k, v in case.params.items():
+        if isinstance(v, Table):
+            row[k] = v.name
+            row[k + ".sha256"] = v.sha256
+        else:
+            row[k] = v
+    return row
+
+
 def _rows(case, rec):
     """The results row and the impacts rows of `case` from its record `rec`."""
     res = rec["result"]
     row = {"case_id": case.id}
-    row.update(case.params)
+    params = _params(case)
+    row.update(params)
     row["duration"] = case.duration
     row["status"] = "error" if res.get("error") else "ok"
     row["error"] = res.get("error") or ""
@@ -60,7 +77,7 @@ def _rows(case, rec):
     impacts = []
     for m in res.get("impacts") or []:
         imp = {"case_id": case.id}
-        imp.update(case.params)
+        imp.update(params)
         imp.update(m)
         impacts.append(imp)
     return row, impacts
@@ -105,9 +122,10 @@ def write_tables(study, out_dir, ident=None):
             b"wheelflat.guid.CoupledSystem": json.dumps(sorted(g for g in guids if g)).encode(),
             b"wheelflat.sweep": json.dumps(list(study.sweep)).encode()}
 
-    # The String parameters (tables named by path or given inline) are text too.
-    text = set(TEXT) | {n for n, v in study.fixed.items() if isinstance(v, str)} | {
-        n for n, vs in study.sweep.items() if any(isinstance(x, str) for x in vs)}
+    # The String parameters (tables by name, and their hashes) are text too.
+    strings = {n for n, v in study.fixed.items() if isinstance(v, (str, Table))} | {
+        n for n, vs in study.sweep.items() if any(isinstance(x, (str, Table)) for x in vs)}
+    text = set(TEXT) | strings | {n + ".sha256" for n in strings}
 
     def schema(names):
         fields = [pa.field(n, pa.string() if n in text else pa.int64() if n == "k" else pa.float64())
@@ -155,15 +173,19 @@ def write_tables(study, out_dir, ident=None):
         for part in parts:
             os.replace(part, part[:-len(".part")])
     except BaseException:
-        for pw, fh in writers.values():
+        # Every writer closed and every part removed, whatever fails on the way: on a
+        # full disk closing the CSV fails too (its buffer cannot be written), which
+        # stopped this cleanup and left the .part files.
+        for w in (w for pair in writers.values() for w in pair):
             try:
-                pw.close()
+                w.close()
             except Exception:
                 pass
-            fh.close()
         for part in parts:
-            if os.path.exists(part):
+            try:
                 os.remove(part)
+            except OSError:
+                pass
         raise
     return pd.read_parquet(os.path.join(out_dir, "results.parquet"))
 
