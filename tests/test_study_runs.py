@@ -126,6 +126,18 @@ def _inline(table):
     return "; ".join(line for line in table.splitlines() if not line.startswith("#"))
 
 
+RECORDING_RUNNER = """\
+import os
+for line in sys.stdin:
+    with open(os.path.join({folder!r}, str(os.getpid())), "a") as fh:
+        fh.write(line)
+    child.stdin.write(line)
+    child.stdin.flush()
+    sys.stdout.write(child.stdout.readline())
+    sys.stdout.flush()
+"""
+
+
 def test_the_workers_run_the_table_the_client_read_never_a_file_at_its_path(tmp_path, runner):
     # Issue 38 (N1): a table named by its path was read by each worker from its own
     # file at that path; a cluster whose workers saw another file there gave "3 of 3
@@ -139,9 +151,17 @@ def test_the_workers_run_the_table_the_client_read_never_a_file_at_its_path(tmp_
     p.write_text(DIPPED.format(name="dip", profile="profile.txt", speeds="[15.0, 20.0]"))
     s = load_study(p)
     profile.write_text(WORKERS)
-    on_dask, n = run_study(s, str(tmp_path / "dask"), workers=2, chunk=1, runner_path=runner, progress=False,
-                           plots=False, log=lambda *_: None)
+    # The workers' runners write down the lines they get.
+    seen = tmp_path / "lines"
+    seen.mkdir()
+    recording = fake_runner(tmp_path / "recording_runner", runner, RECORDING_RUNNER.format(folder=str(seen)))
+    on_dask, n = run_study(s, str(tmp_path / "dask"), workers=2, chunk=1, runner_path=str(recording),
+                           progress=False, plots=False, log=lambda *_: None)
     assert n == 2 and (on_dask["status"] == "ok").all()
+    lines = [line for f in seen.iterdir() for line in f.read_text().splitlines() if "speed=" in line]
+    assert len(lines) == 2 and len({f.name for f in seen.iterdir()}) >= 1
+    for line in lines:
+        assert "rail.left.profile=0,0;8,0;8.5,-2e-3;9,0;30,0; " in line and "profile.txt" not in line, line
     # The same cases with each table written out in the study file, run serially.
     runs = {}
     for name, table in (("clients", CLIENTS), ("workers", WORKERS)):
