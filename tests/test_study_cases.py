@@ -434,12 +434,25 @@ def test_the_fast_case_ids_are_the_cases_own():
                      keep=("primary.left.force", "rail.left.z")),
                Study("b", 0.12, {}, {"speed": [1.0, 2.0]}, combine="zip"),
                Study("c", 1e-3, {"speed": 3.0}, {}),
-               Study("d", 0.5, {}, {})]
+               Study("d", 0.5, {}, {}),
+               # Tables: by their content's hash (issue 38).
+               Study("e", 0.1, {"rail.left.profile": "0 0; 8 0; 8.5 -2e-3; 9 0; 30 0"},
+                     {"wheel.left.out_of_roundness": ["", "0 0\n3 1e-4\n6 0"], "speed": [1.0, 2.0]})]
     for s in studies:
         cases = list(s.iter_cases())
         assert len(cases) == s.count()
         for c in cases:
             assert c.id == Case(c.params, c.duration, c.keep).id, (s.name, c.params)
+    # The same table written otherwise (blanks, a comment, commas) is the same case; a
+    # changed point is another.
+    e = [c.id for c in studies[4].iter_cases()]
+    other = Study("e", 0.1, {"rail.left.profile": "0,0;8,0;8.5,-2e-3;9,0;30,0"},
+                  {"wheel.left.out_of_roundness": ["", "# angle deviation\n0 0\n3 1e-4\n6 0\n"], "speed": [1.0, 2.0]})
+    assert [c.id for c in other.iter_cases()] == e
+    changed = Study("e", 0.1, {"rail.left.profile": "0 0; 8 0; 8.5 -2e-3; 9 0; 30 0"},
+                    {"wheel.left.out_of_roundness": ["", "0 0\n3 2e-4\n6 0"], "speed": [1.0, 2.0]})
+    ids = [c.id for c in changed.iter_cases()]
+    assert ids[:2] == e[:2] and not set(ids[2:]) & set(e)
 
 
 def test_a_refused_table_file_is_named_but_its_content_never_quoted(tmp_path, runner):
