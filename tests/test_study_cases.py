@@ -566,9 +566,6 @@ def test_no_part_file_is_left_after_a_full_disk(tmp_path, study, runner, monkeyp
     assert {n: (out / n).read_bytes() for n in before} == before
 
 
-@pytest.mark.xfail(strict=True, reason="issue 38: src/sim/build.rs gives an empty range for track.void.position "
-                                       "when track.void.sleepers exceeds the fixed track's sleepers (Rust fix "
-                                       "asked of the engine's owner)")
 def test_a_run_of_hanging_sleepers_longer_than_the_track_is_refused_with_a_range_that_holds_values(runner):
     # Issue 38 (N15): "-0.3425 m <= track.void.position < -46.9225 m": a range nothing is in.
     import json

@@ -391,6 +391,19 @@ impl Simulation {
         if let (Some(v), None, TrackState::Discrete(t)) = (&sim.voids, &sim.window, &sim.track) {
             // On a fixed track every hanging sleeper must be one of its sleepers.
             let (a, spans) = (t.params().sleeper_spacing, t.params().spans);
+            // A run longer than the track has sleepers has no position at all: name the
+            // count, not an empty range of positions (issue 38, N15).
+            if v.sleepers > spans + 1 {
+                return Err(out_of_range(
+                    "track.void.sleepers",
+                    v.sleepers as f64,
+                    format!(
+                        "1 <= track.void.sleepers <= {} (the fixed track's sleepers: \
+                         track.spans + 1, track.spans = {spans})",
+                        spans + 1
+                    ),
+                ));
+            }
             let first = (v.position / a).round();
             if !(first >= 0.0 && first + v.sleepers as f64 - 1.0 <= spans as f64) {
                 return Err(out_of_range(
