@@ -27,7 +27,7 @@ from .run import DATA, ROOT, default_runner, installed
 def fmu_paths():
     """The five FMUs by name (TrackContact, RollPlaneVehicle, CoupledSystem,
     HalfCarBogie, Wagon): the installed package's, or in a checkout those in fmu/ (built by
-    ``cargo build --release && target/release/build_fmus fmu``)."""
+    ``bash scripts/build_fmus_glibc228.sh fmu``, the portable build the main command makes)."""
     from .buildinfo import FMUS
     where = os.path.join(DATA, "fmu") if installed() else os.path.join(ROOT, "fmu")
     return {name: os.path.join(where, name + ".fmu") for name in FMUS}
