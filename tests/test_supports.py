@@ -99,7 +99,7 @@ def test_hanging_sleepers_on_the_endless_track_close_their_gap_under_the_wheel(c
      "parameter `track.void.position` = 50 is out of range: allowed a run of track.void.sleepers = 3 "
      "sleepers within the fixed track's 31 sleepers: -0.3425 m <= track.void.position < 19.5225 m"),
     ({"track.window.ahead": 0.0, "track.void.sleepers": 40, "track.void.position": 1.0},
-     "track.void.sleepers = 40"),
+     "`track.void.sleepers` = 40 is out of range: allowed 1 <= track.void.sleepers <= 31"),
 ])
 def test_hanging_sleepers_out_of_range_are_refused_by_name(coupled, capfd, start, message):
     with pytest.raises(FMICallException):
