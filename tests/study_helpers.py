@@ -42,6 +42,18 @@ if sys.argv[1:]:
 """
 
 
+# A stand-in runner's loop that stops, without an answer, on the 30 m/s case.
+LOSING_RUNNER = """\
+for line in sys.stdin:
+    if "speed=30" in line:
+        sys.exit(9)   # a runner killed on this case: no answer
+    child.stdin.write(line)
+    child.stdin.flush()
+    sys.stdout.write(child.stdout.readline())
+    sys.stdout.flush()
+"""
+
+
 def fake_runner(path, runner, loop):
     """Writes an executable stand-in for the case runner at `path`: the real `runner`
     behind `loop` (Python, reading `sys.stdin` and writing to `child`); its path."""

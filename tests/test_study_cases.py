@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from study_helpers import ROOT, comparable, fake_runner, load_study, run_study
+from study_helpers import LOSING_RUNNER, ROOT, comparable, fake_runner, load_study, run_study
 
 
 def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
@@ -24,15 +24,6 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
     assert "`speed` = -5 m/s is out of range" in table["error"][1]
 
 
-LOSING_RUNNER = """\
-for line in sys.stdin:
-    if "speed=30" in line:
-        sys.exit(9)   # a runner killed on this case: no answer
-    child.stdin.write(line)
-    child.stdin.flush()
-    sys.stdout.write(child.stdout.readline())
-    sys.stdout.flush()
-"""
 
 # A runner lost on the first try of the 30 m/s case only (the marker file says it was).
 LOSING_ONCE_RUNNER = """\

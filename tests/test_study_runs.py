@@ -15,7 +15,7 @@ import time
 
 import pytest
 
-from study_helpers import ROOT, comparable, fake_runner, load_done, load_study, run_study
+from study_helpers import LOSING_RUNNER, ROOT, comparable, fake_runner, load_done, load_study, run_study
 
 
 def test_a_local_cluster_gives_the_serial_runs_bit_for_bit(study, tmp_path, runner):
@@ -207,17 +207,6 @@ def test_a_resumed_study_runs_again_a_case_whose_table_file_was_edited(tmp_path,
     again, n = run_study(load_study(p), out, log=said.append, **quiet)
     assert n == 0 and "dip: 1 cases, 1 already done, 0 to run" in said, said
     assert again["peak.left"][0] == first["peak.left"][0]
-
-
-LOSING_RUNNER = """\
-for line in sys.stdin:
-    if "speed=30" in line:
-        sys.exit(9)   # a runner killed on this case: no answer
-    child.stdin.write(line)
-    child.stdin.flush()
-    sys.stdout.write(child.stdout.readline())
-    sys.stdout.flush()
-"""
 
 
 def test_on_dask_a_lost_case_runs_again_in_the_same_run_then_fails_by_name(tmp_path, runner):
