@@ -74,6 +74,10 @@ pub struct FmuModel {
     pub(super) master_end: f64,
     /// A vehicle's first step was checked against its forces at rest.
     pub(super) started: bool,
+    /// TrackContact's communication steps off the track's grid (not a whole number of
+    /// track steps) at the contact interface: the first is not warned of, for it may be
+    /// a run's last, shorter step.
+    pub(super) off_grid_steps: u32,
     /// `track.spans` set away from its default on the endless track, which sets its own
     /// length: the value, for the warning at the end of initialisation.
     pub(super) unused_spans: Option<f64>,
@@ -219,6 +223,7 @@ impl Model for FmuModel {
             watch,
             master_end: 0.0,
             started: false,
+            off_grid_steps: 0,
             unused_spans,
         })
     }

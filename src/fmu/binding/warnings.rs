@@ -132,15 +132,23 @@ impl FmuModel {
                 ))
             } else if self.watch.is_coupled()
                 && (ratio - ratio.round()).abs() > 1e-3
-                && !(at_stop && ratio < 1.0)
+                && !at_stop
+                && {
+                    self.off_grid_steps += 1;
+                    self.off_grid_steps > 1
+                }
             {
-                // A last step shorter than the track's, which every master takes when the
-                // stop time is not a whole number of track steps, is no reason to warn.
+                // A run's last step, shorter than the others when the stop time is not a
+                // whole number of them, is no reason to warn; masters such as OMSimulator
+                // and PyFMI's Master do not give the stop time (stopTimeDefined false), so
+                // the first step off the grid is not warned of, the second is.
                 Some(StepWarning::once(
                     "contact step grid",
                     format!(
                         "at t = {time} s the communication step {} s is {ratio:.3} track steps \
-                     (solver.step = {} s): the track steps on its own grid, so the wheel \
+                     (solver.step = {} s), the second step of this run off the track's grid \
+                     (the first is not warned of: it may be a run's last, shorter step): \
+                     the track steps on its own grid, so the wheel \
                      heights and contact forces meet at other times than the master's (the \
                      peak of the reference flat +4.7 % at half a track step); use a whole \
                      number of solver.step",

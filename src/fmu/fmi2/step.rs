@@ -112,11 +112,12 @@ impl<M: Model> Instance<M> {
             .as_mut()
             .and_then(|m| m.step_warning(end, at_stop));
         if let Some(w) = warning {
-            // FMI 2.0 (2.1.3): fmi2Warning reports a non-critical problem when it is
-            // detected, and the logger is called with it. A condition is detected when it
-            // starts and when it worsens WORSENED times; a step that ends in it unchanged
-            // detects nothing new and returns fmi2OK, logging nothing (a warning at every
-            // step stopped C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
+            // FMI 2.0.5 (2.1.3): fmi2Warning says "things are not quite right, but the
+            // computation can continue", with the logger called (FMI 3.0: "a non-critical
+            // problem was detected"). A condition is reported when it starts and when it
+            // worsens WORSENED times; a step that ends in it unchanged has nothing new to
+            // report and returns fmi2OK, logging nothing (a warning at every step stopped
+            // C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
             let last = self.step_warned.iter_mut().find(|(k, _)| *k == w.kind);
             match last {
                 Some((_, s)) if w.severity < WORSENED * *s => return Ok(()),

@@ -345,3 +345,42 @@ fn input_derivatives_first_given_late_are_anchored_where_given_in_either_order()
         a.iter().cloned().fold(f64::MAX, f64::min)
     );
 }
+
+#[test]
+fn a_single_step_off_the_track_grid_is_not_warned_of_and_a_second_is() {
+    // Issue 38 (N10): OMSimulator and PyFMI's Master stop at any fmi2Warning and give no
+    // stop time; their run of the shipped pair to 0.6 s ended at the last step, shorter
+    // than the track's ("use a whole number of solver.step").
+    let run = |stop: Option<f64>| {
+        let (mut i, log) = instance(Kind::TrackContact);
+        i.setup_experiment(0.0, stop).unwrap();
+        i.enter_initialization().unwrap();
+        i.exit_initialization().unwrap();
+        let dt = real(&mut i, vr::SOLVER_STEP);
+        let mut z = [0.0; 2];
+        i.get_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z], &mut z)
+            .unwrap();
+        let mut statuses = Vec::new();
+        let mut t = 0.0;
+        for h in [dt, dt, dt, 0.3 * dt, 0.3 * dt, 0.3 * dt] {
+            i.set_real(&[vr::WHEEL_LEFT_Z, vr::WHEEL_RIGHT_Z], &z)
+                .unwrap();
+            statuses.push(i.do_step(t, h).map_err(|e| e.status));
+            t = i.time();
+        }
+        let warned = (log.lock().unwrap().iter())
+            .filter(|m| m.contains("off the track's grid"))
+            .count();
+        (statuses, warned, dt)
+    };
+    let (statuses, warned, dt) = run(None);
+    assert!(statuses[..4].iter().all(|s| s.is_ok()), "{statuses:?}");
+    assert_eq!(statuses[4], Err(Status::Warning), "{statuses:?}");
+    assert!(statuses[5].is_ok(), "{statuses:?}");
+    assert_eq!(warned, 1);
+    // A master that gives the stop time: its last step is never warned of (the steps
+    // after it are refused, past stopTime).
+    let (statuses, warned, _) = run(Some(3.3 * dt));
+    assert!(statuses[..4].iter().all(|s| s.is_ok()), "{statuses:?}");
+    assert_eq!(warned, 0, "{statuses:?}");
+}
