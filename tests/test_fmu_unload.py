@@ -11,7 +11,8 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-CYCLES = 1000
+# WHEELFLAT_UNLOAD_CYCLES=10000 for the figure in issue 38's note (pytest -s prints it).
+CYCLES = int(os.environ.get("WHEELFLAT_UNLOAD_CYCLES", "1000"))
 # Resident growth allowed over the cycles after the first ten (MB): the issue's bound.
 GROWTH_MB = 20.0
 
@@ -57,5 +58,6 @@ def test_every_fmu_unloads_at_dlclose_and_a_thousand_cycles_keep_memory_flat(pat
     for _ in range(CYCLES - 10):
         cycle(md, folder)
     grown = resident_mb() - before
+    print(f"{name}: {CYCLES} cycles, resident memory {grown:+.2f} MB after the first ten")
     assert not mapped(library)
     assert grown < GROWTH_MB, f"{name}: {grown:.1f} MB more after {CYCLES} cycles"
