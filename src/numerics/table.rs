@@ -115,13 +115,16 @@ impl Table {
     /// Checks that a wheel can follow the table as a contact does, judged by its
     /// straight pieces: no piece rises or falls more steeply than `max_slope` (units of
     /// `y` per metre), and at no point does the slope change by more than
-    /// `max_curvature` (1/m) times the shorter of the two pieces that meet there (a
-    /// sampled curve turns by its curvature times the spacing at each point; beyond the
-    /// ends the table holds its end values, so an end counts as a point where its piece
-    /// meets a slope of 0, or the piece to the first point a period on when the table
-    /// repeats every `period` of `x`). `metres_per_x` converts `x` to
-    /// metres (1 for positions, the wheel radius for angles). `limit` says where the
-    /// two limits come from.
+    /// `max_curvature` (1/m) times the shorter of the two pieces that meet there, nor by
+    /// more than `max_curvature` times `corner` (m). A sampled curve turns at each point
+    /// by its curvature times the spacing; a corner between long pieces is a turn at a
+    /// point all the same, which the contact, reading the table at the wheel's point,
+    /// meets as a jump of the wheel's vertical velocity: it is held to what the
+    /// reference curve turns at a point when sampled every `corner`. Beyond the ends the
+    /// table holds its end values, so an end counts as a point where its piece meets a
+    /// slope of 0, or the piece to the first point a period on when the table repeats
+    /// every `period` of `x`. `metres_per_x` converts `x` to metres (1 for positions,
+    /// the wheel radius for angles). `limit` says where the limits come from.
     ///
     /// Errors: the first piece or point beyond a limit, naming the table, the point (from
     /// 1), the value and the limit.
@@ -130,7 +133,7 @@ impl Table {
         name: &str,
         metres_per_x: f64,
         period: Option<f64>,
-        (max_slope, max_curvature): (f64, f64),
+        (max_slope, max_curvature, corner): (f64, f64, f64),
         limit: &str,
     ) -> Result<()> {
         let (x, y) = (&self.x, &self.y);
@@ -149,8 +152,15 @@ impl Table {
         for i in 0..pieces {
             let (s, _) = piece(i);
             if s.abs() > max_slope {
+                let j = (i + 1) % n;
                 return Err(out_of_range(
-                    &format!("{name}, points {} to {}", i + 1, (i + 1) % n + 1),
+                    &format!(
+                        "{name}, points {} to {} (x = {} to {})",
+                        i + 1,
+                        j + 1,
+                        crate::error::num(x[i]),
+                        crate::error::num(x[j])
+                    ),
                     s,
                     format!("a slope of at most {max_slope:.4} either way ({limit})"),
                 ));
@@ -167,12 +177,23 @@ impl Table {
             } else {
                 (0.0, f64::INFINITY)
             };
-            let turn = (after.0 - before.0).abs() / before.1.min(after.1);
-            if turn > max_curvature {
+            let turn = (after.0 - before.0).abs();
+            let over = before.1.min(after.1).min(corner);
+            if turn > max_curvature * over {
                 return Err(out_of_range(
-                    &format!("{name}, point {} (change of slope per metre)", i + 1),
+                    &format!(
+                        "{name}, point {} (change of slope at x = {})",
+                        i + 1,
+                        crate::error::num(x[i])
+                    ),
                     turn,
-                    format!("at most {max_curvature:.3} 1/m ({limit})"),
+                    format!(
+                        "at most {max_curvature:.3} 1/m times the shorter piece there, and at \
+                         most {:.4} at any point ({max_curvature:.3} 1/m over {corner} m), \
+                         here {:.4} ({limit})",
+                        max_curvature * corner,
+                        max_curvature * over
+                    ),
                 ));
             }
         }
@@ -278,7 +299,7 @@ mod tests {
 
     #[test]
     fn a_table_steeper_or_sharper_than_the_limits_is_refused_at_its_point() {
-        let limits = (0.5, 15.0);
+        let limits = (0.5, 15.0, 1.0);
         // A ramp of slope 0.25 over 1 m each side of a plateau: turns of 0.25 in 1 m.
         let ok = Table::parse("0 0; 1 0.25; 2 0.25; 3 0", "t").unwrap();
         ok.check_followable("t", 1.0, None, limits, "test").unwrap();
@@ -288,7 +309,10 @@ mod tests {
             .check_followable("t", 1.0, None, limits, "test")
             .unwrap_err();
         let e = e.to_string();
-        assert!(e.contains("points 2 to 3") && e.contains("0.6"), "{e}");
+        assert!(
+            e.contains("points 2 to 3 (x = 1 to 2)") && e.contains("0.6"),
+            "{e}"
+        );
         // The same table in centimetres of x is 100 times steeper.
         assert!(
             ok.check_followable("t", 0.01, None, limits, "test")
@@ -301,7 +325,7 @@ mod tests {
             .check_followable("t", 1.0, None, limits, "test")
             .unwrap_err();
         let e = e.to_string();
-        assert!(e.contains("point 3 (change of slope"), "{e}");
+        assert!(e.contains("point 3 (change of slope at x = 1)"), "{e}");
         assert!(e.contains("at most 15.000 1/m"), "{e}");
         let lower = Table::parse("0 0; 0.99 0; 1 0.0007; 1.01 0; 2 0", "t").unwrap();
         lower
@@ -323,5 +347,19 @@ mod tests {
             .check_followable("t", 1.0, Some(2.5), limits, "test")
             .unwrap_err();
         assert!(e.to_string().contains("points 3 to 1"), "{e}");
+        // A corner between long pieces: a turn of 0.4 at point 2 passes against 15 1/m
+        // times 1 m pieces, not against 15 1/m over a corner length of 0.02 m (0.3).
+        let corner = Table::parse("0 0; 1 0; 2 0.4; 3 0.4", "t").unwrap();
+        corner
+            .check_followable("t", 1.0, None, limits, "test")
+            .unwrap();
+        let e = corner
+            .check_followable("t", 1.0, None, (0.5, 15.0, 0.02), "test")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("point 2 (change of slope at x = 1)") && e.contains("here 0.3000"),
+            "{e}"
+        );
     }
 }

@@ -53,12 +53,12 @@ impl OutOfRoundness {
     /// Checks that the contact can follow the table on a wheel of `radius` (m): the
     /// deviation against the distance along the tread (`radius` times the angle, once
     /// round the wheel, the last point joining the first), held to `limits` (slope,
-    /// change of slope per metre; `source` says where they come from,
+    /// change of slope per metre, corner length; `source` says where they come from,
     /// [`crate::numerics::Table::check_followable`]). `name` names the table.
     pub fn check_followable(
         &self,
         radius: f64,
-        limits: (f64, f64),
+        limits: (f64, f64, f64),
         source: &str,
         name: &str,
     ) -> Result<()> {

@@ -18,9 +18,12 @@
 //! the vehicle's heights over only after the first step), but the next inputs can: a
 //! partner at rest moves by a step's motion, far less than the static deflection. When
 //! an input given between the first and the second step is more than half the static
-//! deflection (`|static|`) away from the first step's, the first step's was not the
-//! partner's rest: the datum is taken again from it, and the step returns fmi2Warning
-//! naming `inputs.datum`, the first-step input and the static height (issue 38, N5).
+//! deflection (`|static|`) away from the first step's, the step returns fmi2Warning
+//! naming `inputs.datum`, the first-step input and the static height (issue 38, N5);
+//! where the first step's input was exactly 0, a connector's initial value and not the
+//! partner's rest, the datum is taken again from the new input. A first input other
+//! than 0 is the partner's own and is kept: a partner that really moves that far in one
+//! step (a long step at an impact) is warned of, not re-measured.
 //! Any later force beyond the health bound names the datum's offsets when one is more
 //! than half the static deflection ([`InputDatum::explain`]).
 
@@ -48,10 +51,12 @@ pub(super) struct InputDatum {
     /// Per wheelset: steps since the offsets were fixed, up to 2 (1: between the first
     /// step and the second, when a move is judged).
     age: Vec<u8>,
-    /// Per wheelset and side: the first step's input, when the datum was taken again.
+    /// Per wheelset and side: the first step's input, when the datum was taken again or
+    /// a move from it warned of.
     retaken: Vec<[Option<f64>; 2]>,
-    /// The re-takes not yet warned of: wheelset, side, first input, the input now (m).
-    pending: Vec<(usize, usize, f64, f64)>,
+    /// The moves not yet warned of: wheelset, side, first input, the input now (m),
+    /// whether the datum was taken again.
+    pending: Vec<(usize, usize, f64, f64, bool)>,
 }
 
 /// The name of displacement input `side` (0 left, 1 right) of wheelset `k` (from 0):
@@ -139,9 +144,13 @@ impl InputDatum {
             for s in (0..2).filter(|&s| set[s]) {
                 let first = self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s]);
                 if (raw[s] - first).abs() > 0.5 * self.statics[k][s].abs() {
-                    self.offsets[k][s] = self.statics[k][s] - raw[s];
+                    // Only a connector's initial 0 is taken for no input at all.
+                    let again = first == 0.0;
+                    if again {
+                        self.offsets[k][s] = self.statics[k][s] - raw[s];
+                    }
                     if self.retaken[k][s].is_none() {
-                        self.pending.push((k, s, first, raw[s]));
+                        self.pending.push((k, s, first, raw[s], again));
                     }
                     self.retaken[k][s] = Some(first);
                 }
@@ -156,8 +165,9 @@ impl InputDatum {
         if self.pending.is_empty() {
             return None;
         }
+        let again = self.pending.iter().any(|p| p.4);
         let moves: Vec<String> = (self.pending.drain(..))
-            .map(|(k, s, first, now)| {
+            .map(|(k, s, first, now, _)| {
                 format!(
                     "{} = {} at the first step, {} now (static {})",
                     input_name(axle_box, k, s),
@@ -167,15 +177,23 @@ impl InputDatum {
                 )
             })
             .collect();
+        let what = if again {
+            "the first step's inputs of 0 were not the partner's rest (connectors that \
+             start at 0, as fmpy's simulate_ssp starts them, before the partner's heights \
+             come in): the datum is taken from this step's inputs instead, and the track's \
+             first step held its static state. Start the partner's connectors at its \
+             static heights, or set inputs.datum = absolute and hand the partner the \
+             track's static_wheel_z.* first"
+        } else {
+            "if the partner was not at rest on its first inputs, start it at rest or set \
+             inputs.datum = absolute and hand it the track's static_wheel_z.* first; a \
+             partner at rest that moves this far in one step takes too long a \
+             communication step"
+        };
         Some(format!(
             "at t = {time} s the displacement inputs moved by more than half the static \
              deflection since the first step: {}. With inputs.datum = first_step the first \
-             step's inputs stand for the static heights, but these were not the partner's \
-             rest (connectors that start at 0, as fmpy's simulate_ssp starts them, before \
-             the partner's heights come in): the datum is taken from this step's inputs \
-             instead, and the track's first step held its static state. Start the \
-             partner's connectors at its static heights, or set inputs.datum = absolute and \
-             hand the partner the track's static_wheel_z.* first",
+             step's inputs stand for the static heights; {what}",
             moves.join("; ")
         ))
     }
@@ -437,6 +455,21 @@ mod tests {
                  -1.5000 mm (offset -1.5000 mm)"
             ),
             "{named}"
+        );
+        // A first input other than 0 is the partner's own: a move of more than half the
+        // static deflection after it is warned of, and the offsets stay (a partner that
+        // really moves, at too long a step).
+        let mut g = InputDatum::new(true, vec![statics]);
+        g.apply(0, [-1.0e-3; 2], [true; 2], true);
+        g.fix();
+        let z = g.apply(0, [-2.0e-3, -1.0e-3], [true; 2], false);
+        assert!((z[0] - (-1.5e-3 - 1.0e-3)).abs() < 1e-15, "{z:?}");
+        let w = g.take_warning(false, 5e-3).unwrap();
+        assert!(
+            w.contains("wheel.left.z = -1.0000 mm at the first step, -2.0000 mm now")
+                && w.contains("too long a communication step")
+                && !w.contains("right"),
+            "{w}"
         );
         // Absolute inputs are never moved.
         let mut a = InputDatum::new(false, vec![statics]);

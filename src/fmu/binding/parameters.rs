@@ -18,6 +18,7 @@ use crate::track::{
 };
 use crate::vehicle::{HalfCarParams, RollPlaneParams, WagonParams};
 use crate::wheel::{FlatShape, FlatSpec, OutOfRoundness};
+use std::io::Read;
 use std::sync::Arc;
 
 /// Track parameters (fixed rail ends).
@@ -317,20 +318,27 @@ pub fn table_content(name: &str, text: &str) -> Result<Arc<str>, Error> {
     if !meta.is_file() {
         return Err(refuse("not a regular file".into()));
     }
+    let too_large = || {
+        refuse(format!(
+            "the file has more than {MAX_TABLE_FILE} bytes; a table's file holds at most \
+             {MAX_TABLE_FILE} (1,000,000 points)"
+        ))
+    };
     if meta.len() > MAX_TABLE_FILE {
-        return Err(refuse(format!(
-            "the file has {} bytes; a table's file holds at most {MAX_TABLE_FILE} (1,000,000 \
-             points)",
-            meta.len()
-        )));
+        return Err(too_large());
     }
-    let content = std::fs::read_to_string(text).map_err(|e| {
-        let why = match e.kind() {
-            std::io::ErrorKind::InvalidData => "the file is not UTF-8 text".to_string(),
-            _ => format!("cannot read the table's file ({e})"),
-        };
-        refuse(why)
-    })?;
+    // Read at most a word past the limit (files such as /proc/self/pagemap read whole
+    // words only): a file's stated size may be 0 (/proc) or out of date (a file still
+    // growing), and it is never read further (issue 38).
+    let mut bytes = Vec::new();
+    std::fs::File::open(text)
+        .and_then(|f| f.take(MAX_TABLE_FILE + 8).read_to_end(&mut bytes))
+        .map_err(|e| refuse(format!("cannot read the table's file ({e})")))?;
+    if bytes.len() as u64 > MAX_TABLE_FILE {
+        return Err(too_large());
+    }
+    let content =
+        String::from_utf8(bytes).map_err(|_| refuse("the file is not UTF-8 text".into()))?;
     Ok(Arc::from(content))
 }
 

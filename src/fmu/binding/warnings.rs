@@ -239,6 +239,20 @@ fn off_rest(u: &VehicleUnit) -> Option<String> {
         }
     }
     let (off, held, rest) = worst?;
+    // Every force exactly 0: connectors at their initial value, as fmpy's simulate_ssp
+    // starts them, before the partner's forces come in (issue 38).
+    let all_zero = (0..u.wheelsets())
+        .filter_map(|k| u.held_forces_of(k))
+        .all(|f| f == [0.0; 2]);
+    if all_zero {
+        return Some(format!(
+            "the {names} that drove the first step are all 0 N, not the {} N that hold this \
+             vehicle at rest: connectors that start at 0 (fmpy's simulate_ssp starts them \
+             so) before the partner's forces come in; the vehicle fell freely for that step. \
+             Start the connectors at the partner's initial outputs where the master allows",
+            num(rest)
+        ));
+    }
     let load = u.static_load();
     Some(format!(
         "the {names} that drove the first step ({} N) are {:.1} % off the {} N that hold this \

@@ -684,7 +684,7 @@ fn a_table_steeper_or_sharper_than_the_steepest_dipped_weld_is_refused_when_set(
     assert_eq!(e.status, Status::Error);
     for part in [
         "rail.left.profile",
-        "points 2 to 3",
+        "points 2 to 3 (x = 1.5 to 1.5",
         "0.3142",
         "rail.defect.depth",
     ] {
@@ -697,7 +697,7 @@ fn a_table_steeper_or_sharper_than_the_steepest_dipped_weld_is_refused_when_set(
         .set_string(&[vr::RAIL_LEFT_PROFILE], &[kinked])
         .unwrap_err();
     assert!(
-        e.message.contains("point 2 (change of slope") && e.message.contains("19.739"),
+        e.message.contains("point 2 (change of slope at x = 1.5)") && e.message.contains("19.739"),
         "{}",
         e.message
     );
@@ -727,6 +727,21 @@ fn a_table_steeper_or_sharper_than_the_steepest_dipped_weld_is_refused_when_set(
     );
     assert!(e.message.contains("line 1"), "{}", e.message);
     std::fs::remove_file(&path).unwrap();
+    // A file whose stated size is 0 but whose content is endless (the breaker's
+    // /proc/self/pagemap, about 256 GB) is read to the limit and refused by size.
+    if std::fs::File::open("/proc/self/pagemap").is_ok() {
+        let e = i
+            .set_string(
+                &[vr::RAIL_LEFT_PROFILE],
+                &["/proc/self/pagemap".to_string()],
+            )
+            .unwrap_err();
+        assert!(
+            e.message.contains("more than 100000000 bytes"),
+            "{}",
+            e.message
+        );
+    }
     // A byte-order mark before the first point is skipped.
     let path = table_file("bom", "\u{feff}0 0\n10 1e-4\n20 0\n");
     i.set_string(
@@ -735,4 +750,25 @@ fn a_table_steeper_or_sharper_than_the_steepest_dipped_weld_is_refused_when_set(
     )
     .unwrap();
     std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn a_vehicle_whose_first_forces_are_all_zero_is_told_of_connectors_that_start_at_zero() {
+    // Issue 38: fmpy's simulate_ssp starts every connector at 0; the vehicle's warning
+    // told the user to set TrackContact's static_load.*, which already matched.
+    let (mut i, log) = instance(Kind::RollPlaneVehicle);
+    i.enter_initialization().unwrap();
+    i.exit_initialization().unwrap();
+    i.set_real(
+        &[vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
+        &[0.0, 0.0],
+    )
+    .unwrap();
+    assert_eq!(i.do_step(0.0, 1e-4).unwrap_err().status, Status::Warning);
+    let log = log.lock().unwrap();
+    let w = log.last().unwrap();
+    assert!(
+        w.contains("are all 0 N") && w.contains("simulate_ssp") && !w.contains("static_load"),
+        "{w}"
+    );
 }
