@@ -61,8 +61,10 @@ def main():
     print(f"communication steps: {steps} of {args.stop / steps * 1e6:.3f} us" if steps else "no steps")
     print(f"peak contact force, left wheel:  {r['contact.left.max_force'][-1] / 1e3:9.2f} kN")
     print(f"peak contact force, right wheel: {r['contact.right.max_force'][-1] / 1e3:9.2f} kN")
-    print(f"wrote {csv}")
-    print(f"wrote {png}")
+    # Relative to the working folder when inside it (the README's example), else whole.
+    for f in (csv, png):
+        rel = os.path.relpath(f)
+        print(f"wrote {f if rel.startswith('..') else rel}")
     print(f"wall time: build {t1 - t0:.1f} s, co-simulation {t2 - t1:.1f} s")
 
 
