@@ -272,8 +272,24 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
      "`rail.left.profile` = '/dev/zero': /dev/zero is not a regular file (a device); allowed: a table's file"),
     ('name = "s"\nduration = 0.1\n[sweep]\n"wheel.left.out_of_roundness" = ["/tmp"]\n',
      "`wheel.left.out_of_roundness` = '/tmp': /tmp is not a regular file (a folder)"),
+    # Issue 38 (item 3): a table parameter's value is always text, a path or a table, so
+    # "20" is a file's path there (a file named 20 is read: the next test).
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = "20"\n',
-     "`rail.left.profile` = '20': a table: its file's path, the table itself"),
+     "`rail.left.profile` = '20': not a table: no file at "),
+    # Issue 38 (item 2): a number written as text gave a TypeError traceback, exit 1.
+    ('name = "s"\nduration = 0.1\n[fixed]\nspeed = "20"\n',
+     "`speed` = '20' is text (in quotes), but `speed` takes a number: 0 <= speed <= 200; write it without "
+     "quotes: speed = 20"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = ["nan"]\n',
+     "`speed` = 'nan' is text (in quotes), but `speed` takes a number: 0 <= speed <= 200"),
+    ('name = "s"\nduration = 0.1\n[sweep]\nspeed = [10.0, "20"]\n',
+     "`speed` = '20' is text (in quotes), but `speed` takes a number"),
+    ('name = "s"\nduration = 0.1\n[fixed]\nwheelsets = "two"\n',
+     "`wheelsets` = 'two' is text (in quotes), but `wheelsets` takes a number: a whole number, 1 <= wheelsets <= 4"),
+    # Issue 38 (item 3): an enumeration's name was refused as "not a table: no file at".
+    ('name = "s"\nduration = 0.1\n[fixed]\n"vehicle.model" = "half_car"\n',
+     "`vehicle.model` = 'half_car' is text (in quotes), but `vehicle.model` takes a number: one of 1 = roll_plane, "
+     "2 = half_car, 3 = wagon (an enumeration: its number); for half_car write vehicle.model = 2"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = 20\n', "`rail.left.profile` = 20.0: a table"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = "0 0; 1 x"\n',
      "`rail.left.profile` (the table written out): line 1, its point 2 after a `;`: not two numbers (2 fields)"),
@@ -289,6 +305,29 @@ def test_bad_study_files_are_refused_before_anything_runs(tmp_path, runner, text
                         "--runner", runner, "--no-progress"], env=env, capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and said in r.stderr and "Traceback" not in r.stderr, r.stderr
     assert not (tmp_path / "o" / "cases.jsonl").exists()
+
+
+def test_a_table_file_named_like_a_number_is_a_table_and_text_for_a_number_is_refused_whatever_file_it_names(
+        tmp_path, runner):
+    # Issue 38 (item 3): files named `123` and `nan` given to a table parameter were
+    # refused as numbers; a table parameter's value is always text (a path or a table).
+    (tmp_path / "123").write_text("0 0\n10 0\n")
+    (tmp_path / "nan").write_text("0 0\n10 1e-6\n")
+    (tmp_path / "20").write_text("0 0\n10 0\n")
+    p = tmp_path / "s.toml"
+    p.write_text('name = "s"\nduration = 0.01\n[sweep]\n"rail.left.profile" = ["123", "nan"]\n')
+    s = load_study(p)
+    assert [t.name for t in s.sweep["rail.left.profile"]] == [str(tmp_path / "123"), str(tmp_path / "nan")]
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"), "--runner",
+           runner, "--no-progress", "--no-plots"]
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "(2 of 2 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
+    # speed = "20" is text for a number even with a file named 20 beside the study.
+    p.write_text('name = "s"\nduration = 0.01\n[fixed]\nspeed = "20"\n')
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "`speed` = '20' is text (in quotes), but `speed` takes a number" in r.stderr \
+        and "Traceback" not in r.stderr, r.stderr
 
 
 def test_damaged_results_and_passing_failures_run_again(study, tmp_path, runner):

@@ -269,6 +269,77 @@ def test_a_million_case_study_starts_within_seconds_in_little_memory(tmp_path, r
     assert len(load_done(str(out))) > 100
 
 
+def test_two_sigterms_10_ms_apart_stop_the_study_quietly_with_130(tmp_path, runner):
+    # Issue 38 (item 4): the second of two SIGTERMs (GNU timeout, a double Ctrl-C) gave a
+    # KeyboardInterrupt traceback from stop_runners.
+    p = tmp_path / "long.toml"
+    p.write_text('name = "long"\nduration = 0.5\n[sweep]\nspeed = { range = [10.0, 49.0, 1.0] }\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    for attempt in range(3):
+        out = tmp_path / f"o{attempt}"
+        proc = subprocess.Popen([sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(out),
+                                 "--no-progress", "--no-plots", "--runner", runner], env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        records = out / "cases.jsonl"
+        t0 = time.perf_counter()
+        # Cases running: the first results written (a case takes about 0.1 s).
+        while not (records.exists() and records.stat().st_size > 0) and time.perf_counter() - t0 < 60:
+            time.sleep(0.01)
+        time.sleep(0.05 * attempt)
+        proc.send_signal(signal.SIGTERM)
+        time.sleep(0.01)
+        proc.send_signal(signal.SIGTERM)
+        stdout, stderr = proc.communicate(timeout=60)
+        assert proc.returncode == 130 and "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+        assert "interrupted" in stderr, stderr
+        assert not [f for f in os.listdir(out) if f.endswith(".part")]
+
+
+def test_the_study_command_in_a_checkout_runs_the_portable_runner_of_the_one_build(tmp_path):
+    # Issue 38 (item 1): the command built a runner of its own (cargo build --release, in
+    # target/release/, needing glibc 2.34/2.35) beside the one build's portable runner.
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import wheelflat_fmus as wf
+    from wheelflat_study import run
+    assert os.path.realpath(run.BUILD_SCRIPT) == os.path.realpath(wf.BUILD_SCRIPT)
+    assert os.path.realpath(run.RUNNER) == os.path.realpath(wf.RUNNER_228)
+    t0 = time.perf_counter()
+    path = run.build_runner()
+    took = time.perf_counter() - t0
+    assert os.path.realpath(path) == os.path.realpath(wf.RUNNER_228) == os.path.realpath(run.default_runner())
+    needed = wf.glibc_versions(path)
+    assert needed and max(needed) <= wf.GLIBC_BASELINE, sorted(needed)
+    print(f"build_runner (the one build's runner, up to date): {took:.4f} s")
+    # Built by the one build script only when missing or older than a source it was
+    # built from (cargo's dep-info beside it): a stand-in runner and source here.
+    fake, src = tmp_path / "wheelflat_case", tmp_path / "a b.rs"
+    src.write_text("")
+    fake.write_text("")
+    (tmp_path / "wheelflat_case.d").write_text(f"{fake}: {str(src).replace(' ', chr(92) + ' ')}\n")
+    old = run.RUNNER
+    try:
+        run.RUNNER = str(fake)
+        os.utime(src, (1e9, 1e9))
+        assert not run.runner_stale()
+        os.utime(src, (time.time() + 10, time.time() + 10))
+        assert run.runner_stale()
+        os.utime(src, (1e9, 1e9))
+        (tmp_path / "wheelflat_case.d").unlink()
+        assert run.runner_stale()
+        fake.unlink()
+        assert run.runner_stale()
+    finally:
+        run.RUNNER = old
+    # The command without --runner: no build of its own, that runner's answers.
+    p = tmp_path / "one.toml"
+    p.write_text('name = "one"\nduration = 0.01\n[fixed]\nspeed = 20.0\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
+                        "--no-progress", "--no-plots"], env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0 and "(1 of 1 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
+    assert "cargo build" not in r.stderr and "target/release/" not in r.stderr, r.stderr
+
+
 def test_the_installed_package_runs_a_study_on_a_scheduler_and_two_workers_without_a_checkout(study, tmp_path,
                                                                                                runner):
     # Issue 26, "On a real cluster": the workers needed the checkout's runner at the

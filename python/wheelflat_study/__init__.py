@@ -42,5 +42,5 @@ def build_info():
     from .buildinfo import collect
     runner = default_runner()
     if runner is None:
-        raise RuntimeError("no case runner built in this checkout: cargo build --release")
+        raise RuntimeError("no case runner built in this checkout: bash scripts/build_fmus_glibc228.sh fmu")
     return collect(runner, os.path.join(ROOT, "fmu"), ROOT)

@@ -16,13 +16,18 @@ import sys
 
 from .run import (MAX_TIME_LIMIT, MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study,
                   stop_runners)
-from .spec import MAX_CASES, Table, load_study
+from .spec import MAX_CASES, Table, Unread, _finite_text, load_study
 
 
 def main(argv=None):
     """The study command; returns its exit status."""
     try:
         return _main(argv)
+    except KeyboardInterrupt:
+        # Ctrl-C or SIGTERM before the cases started (reading the study, checking it).
+        stop_runners()
+        print("\ninterrupted", file=sys.stderr)
+        return 130
     finally:
         # Arrow's native threads (the tables' Parquet writers) joined while Arrow is
         # alive: left to the interpreter's teardown they can abort the process
@@ -44,7 +49,8 @@ def _main(argv=None):
     ap.add_argument("--no-plots", action="store_true")
     ap.add_argument("--no-progress", action="store_true")
     ap.add_argument("--runner", help="the case runner, at this path for this process and every worker "
-                                     "(default: the installed package's, or in a checkout built with cargo)")
+                                     "(default: the installed package's, or in a checkout the portable one that "
+                                     "bash scripts/build_fmus_glibc228.sh fmu builds, run first)")
     ap.add_argument("--case-time-limit", type=float, metavar="S",
                     help=f"wall time one case may take (s); a case past it is stopped and recorded as "
                          f"failed (default: {TIME_LIMIT_FACTOR:g} times its duration at the cost measured "
@@ -55,11 +61,17 @@ def _main(argv=None):
                          "a stopped runner or a lost worker, always run again)")
     args = ap.parse_args(argv)
     # A batch system's SIGTERM stops the study as Ctrl-C does: the cases done are kept.
+    # Only the first signal stops it; those that follow (GNU timeout's second SIGTERM, a
+    # double Ctrl-C) are ignored while it stops its runners and keeps what it has, so
+    # they give no traceback (SIGKILL still ends it at once).
     import signal
 
     def stop(signum, frame):
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         raise KeyboardInterrupt
     signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, stop)
     if args.version:
         from . import build_info
         try:
@@ -102,7 +114,7 @@ def _main(argv=None):
         print("interrupted while building the case runner", file=sys.stderr)
         return 130
     if not (os.path.isfile(runner) and os.access(runner, os.X_OK)):
-        print(f"--runner {runner}: not an executable file (the case runner, target/release/wheelflat_case)",
+        print(f"--runner {runner}: not an executable file (the case runner: target/x86_64-unknown-linux-gnu/release/wheelflat_case in a checkout)",
               file=sys.stderr)
         return 2
     try:
@@ -173,7 +185,7 @@ def check_variables(study, runner):
             raise ValueError("no variables listed")
     except (OSError, ValueError, subprocess.SubprocessError) as e:
         raise RuntimeError(f"--runner {runner}: does not answer as the case runner does ({type(e).__name__}: "
-                           f"{str(e)[:200]}); give target/release/wheelflat_case or the installed "
+                           f"{str(e)[:200]}); give target/x86_64-unknown-linux-gnu/release/wheelflat_case or the installed "
                            f"wheelflat-case's program") from None
     # A kept name goes into the runner's line as it is: one that is not an output (a
     # blank in it, another token, a newline) would set a parameter or shift the answers.
@@ -187,18 +199,71 @@ def check_variables(study, runner):
             raise ValueError(f"`{name}` is not a parameter or input of CoupledSystem (docs/VARIABLES.md)")
         ty, lo, hi = known[name]
         for v in vs:
-            # A table was read when the study was loaded (spec.read_table); a number
-            # written as text was left as text, to be refused here.
-            if (ty == "String") != isinstance(v, Table):
-                raise ValueError(f"`{name}` = {v!r}: " + ("a table: its file's path, the table itself "
-                                                          "(x y; x y; ...), or \"\" for no table"
-                                                          if ty == "String" else "a number"))
+            # A text was read as a table when the study was loaded (spec.read_table);
+            # one that is not a table is kept with the table's refusal (spec.Unread).
             if ty == "String":
+                if isinstance(v, Unread):
+                    raise ValueError(v.why)
+                if not isinstance(v, Table):
+                    raise ValueError(f"`{name}` = {v!r}: a table: its file's path, the table itself (x y; x y; "
+                                     f"...), or \"\" for no table (a String parameter's value is always text, in "
+                                     f"quotes)")
                 continue
+            if isinstance(v, (Table, Unread)):
+                raise ValueError(takes_a_number(name, v, ty, lo, hi))
             if not lo <= v <= hi:
                 raise ValueError(f"`{name}` = {v:g} is out of range: {lo:g} <= {name} <= {hi:g}")
             if ty == "Integer" and v != int(v):
                 raise ValueError(f"`{name}` = {v:g}: a whole number is needed")
+
+
+def takes_a_number(name, v, ty, lo, hi):
+    """The refusal of text `v` (a :class:`Table` or :class:`Unread`) given to `name`,
+    which takes a number of type `ty` ("Real", "Integer") from `lo` to `hi`; an
+    enumeration's items with their values when CoupledSystem's model description
+    beside the runner lists them."""
+    text = v.text if isinstance(v, Unread) else v.given or v.name
+    items = enumeration_items(name, lo, hi) if ty == "Integer" else None
+    if items:
+        allowed = "one of " + ", ".join(f"{k} = {item}" for k, item in items) + " (an enumeration: its number)"
+    elif ty == "Integer":
+        allowed = f"a whole number, {lo:g} <= {name} <= {hi:g}"
+    else:
+        allowed = f"{lo:g} <= {name} <= {hi:g}"
+    said = f"`{name}` = {text!r} is text (in quotes), but `{name}` takes a number: {allowed}"
+    if _finite_text(text):
+        said += f"; write it without quotes: {name} = {text.strip()}"
+    elif items and text.strip() in {item for _, item in items}:
+        k = dict((item, k) for k, item in items)[text.strip()]
+        said += f"; for {text.strip()} write {name} = {k}"
+    return said
+
+
+def enumeration_items(name, lo, hi):
+    """The items [(value, name), ...] of CoupledSystem's enumeration `name`, read from
+    the description of the variable in this installation's CoupledSystem.fmu (its
+    model description ends it with "(1 = roll_plane, 2 = half_car, 3 = wagon)"); None
+    when there is no such FMU or list, or the list does not cover lo to hi (another
+    build than the runner's)."""
+    import re
+    import zipfile
+    import xml.etree.ElementTree as ET
+    from . import fmu_paths
+    try:
+        with zipfile.ZipFile(fmu_paths()["CoupledSystem"]) as z:
+            root = ET.fromstring(z.read("modelDescription.xml"))
+    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError):
+        return None
+    for var in root.iter("ScalarVariable"):
+        if var.get("name") == name:
+            m = re.search(r"\(((?:[0-9]+ = [A-Za-z_][A-Za-z0-9_]*(?:, )?)+)\)\s*$", var.get("description") or "")
+            if not m:
+                return None
+            items = [(int(k), item) for k, item in re.findall(r"([0-9]+) = ([A-Za-z_][A-Za-z0-9_]*)", m.group(1))]
+            if [k for k, _ in items] != list(range(int(lo), int(hi) + 1)):
+                return None
+            return items
+    return None
 
 
 if __name__ == "__main__":

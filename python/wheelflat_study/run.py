@@ -17,10 +17,15 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # The installed package's own case runner and FMUs (python/setup.py puts them there).
 DATA = os.path.join(HERE, "_data")
 INSTALLED_RUNNER = os.path.join(DATA, "bin", "wheelflat_case")
-# In a checkout: the repository and cargo's build of the runner.
+# In a checkout: the repository, and the case runner of the project's one build,
+# scripts/build_fmus_glibc228.sh (python/wheelflat_fmus.py: BUILD_SCRIPT, RUNNER_228):
+# cargo-zigbuild against the glibc 2.28 baseline, with the FMUs in fmu/. Never a plain
+# `cargo build` of its own (target/release/, which needs the build machine's glibc).
 ROOT = os.path.dirname(os.path.dirname(HERE))
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
-RUNNER = os.path.join(TARGET_DIR, "release", "wheelflat_case")
+BUILD_SCRIPT = os.path.join(ROOT, "scripts", "build_fmus_glibc228.sh")
+FMU_DIR = os.path.join(ROOT, "fmu")
+RUNNER = os.path.join(TARGET_DIR, "x86_64-unknown-linux-gnu", "release", "wheelflat_case")
 
 # The per-case time limit by default: this many times the case's simulated duration at
 # the cost per simulated second measured when the study starts (CoupledSystem's
@@ -41,28 +46,61 @@ def installed():
 
 def default_runner():
     """The case runner of this installation: the installed package's, else this
-    checkout's cargo build (None when neither is there)."""
+    checkout's portable one (RUNNER, from scripts/build_fmus_glibc228.sh; None when
+    neither is there)."""
     for path in (INSTALLED_RUNNER, RUNNER):
         if os.path.isfile(path) and os.access(path, os.X_OK):
             return path
     return None
 
 
+def runner_stale():
+    """Whether the checkout's runner (RUNNER) is missing or older than a file it was
+    built from: those cargo's dep-info beside it lists (RUNNER.d: the sources, the
+    build script's inputs), Cargo.toml, Cargo.lock and the build script; no dep-info
+    is stale too."""
+    try:
+        built = os.stat(RUNNER).st_mtime
+        with open(RUNNER + ".d") as fh:
+            deps = fh.read().split(": ", 1)[1]
+    except (OSError, IndexError):
+        return True
+    import re
+    paths = [p.replace("\\ ", " ") for p in re.split(r"(?<!\\)\s+", deps.strip()) if p]
+    paths += [os.path.join(ROOT, "Cargo.toml"), os.path.join(ROOT, "Cargo.lock"), BUILD_SCRIPT]
+    for path in paths:
+        try:
+            if os.stat(path).st_mtime > built:
+                return True
+        except OSError:
+            return True
+    return False
+
+
 def build_runner():
-    """The case runner: the installed package's, or in a checkout built with cargo
-    (release profile)."""
+    """The case runner: the installed package's, or in a checkout the portable one of
+    the project's one build, ``bash scripts/build_fmus_glibc228.sh fmu`` (the runner
+    and the FMUs against the glibc 2.28 baseline), run here when the runner is missing
+    or older than a source (:func:`runner_stale`; the check takes milliseconds and
+    builds nothing, so an up-to-date runner leaves fmu/ as it is). A first build takes
+    minutes, a changed source rebuilds what it touches."""
     if installed():
         return INSTALLED_RUNNER
-    if not os.path.isfile(os.path.join(ROOT, "Cargo.toml")):
+    if not (os.path.isfile(os.path.join(ROOT, "Cargo.toml")) and os.path.isfile(BUILD_SCRIPT)):
         raise RuntimeError("no case runner: install the package (docs/guide/studies.md) or give --runner")
-    if not os.path.isfile(RUNNER):
-        print("building the case runner (cargo build --release --bin wheelflat_case; a minute or two the "
-              "first time) ...", file=sys.stderr, flush=True)
+    if not runner_stale():
+        return RUNNER
+    print("building the case runner and the FMUs (bash scripts/build_fmus_glibc228.sh fmu, the project's one "
+          "build, against glibc 2.28; " + ("a source changed" if os.path.isfile(RUNNER) else
+                                          "a few minutes the first time") + ") ...", file=sys.stderr, flush=True)
     try:
-        subprocess.check_call(["cargo", "build", "--release", "--quiet", "--bin", "wheelflat_case"], cwd=ROOT)
+        # The packer's list of files is dropped; cargo's progress and errors go to stderr.
+        subprocess.check_call(["bash", BUILD_SCRIPT, FMU_DIR], cwd=ROOT, stdout=subprocess.DEVNULL)
     except (OSError, subprocess.CalledProcessError) as e:
-        raise RuntimeError(f"building the case runner failed ({e}): run cargo build --release --bin "
-                           f"wheelflat_case in {ROOT} to see why, or give --runner") from None
+        raise RuntimeError(f"building the case runner failed ({e}): run bash scripts/build_fmus_glibc228.sh "
+                           f"fmu in {ROOT} to see why, or give --runner") from None
+    if not os.path.isfile(RUNNER):
+        raise RuntimeError(f"bash scripts/build_fmus_glibc228.sh left no case runner at {RUNNER}: give --runner")
     return RUNNER
 
 

@@ -1,5 +1,6 @@
 """Study files: what is fixed, what is swept, and the cases that makes."""
 
+import dataclasses
 import hashlib
 import itertools
 import json
@@ -47,6 +48,8 @@ class Table:
     name: str
     text: str
     sha256: str
+    # The value as the study wrote it (a relative path as given), for refusals only.
+    given: str = field(default="", compare=False, repr=False)
 
     def __repr__(self):
         # Never the content of a file (a refusal may quote a value).
@@ -59,6 +62,22 @@ class Table:
 
 
 NO_TABLE = Table("", "", "")
+
+
+@dataclass(frozen=True)
+class Unread:
+    """A study's text value that is not a table (no file at its path, a file refused,
+    a table written out wrongly): kept as the text with ``why``, the table's refusal,
+    until the variable's type is known. A String parameter's value is always text (a
+    path or a table), so a text that looks like a number ("20", "nan") is a path there,
+    and a file of that name is read; given to a parameter that takes a number, the text
+    is refused as text, whatever file it names (the study command's check_variables,
+    or :meth:`Study.check`)."""
+    text: str
+    why: str
+
+    def __repr__(self):
+        return repr(self.text)
 
 
 @dataclass
@@ -148,9 +167,15 @@ class Study:
         return itertools.product(*lists)
 
     def check(self):
-        """Refuses a study whose cases are not all different, or a zip of lists of
-        different lengths, without making the cases (a million-case study is checked
-        in well under a second)."""
+        """Refuses a text that is not a table (:class:`Unread`), a study whose cases
+        are not all different, or a zip of lists of different lengths, without making
+        the cases (a million-case study is checked in well under a second)."""
+        for name, vs in itertools.chain(((k, [v]) for k, v in self.fixed.items()), self.sweep.items()):
+            for v in vs:
+                if isinstance(v, Unread):
+                    hint = (f" (if `{name}` takes a number, write it without quotes: {name} = {v.text.strip()})"
+                            if _finite_text(v.text) else "")
+                    raise ValueError(v.why + hint)
         names = list(self.sweep)
         lists = [self.sweep[n] for n in names]
         if self.combine == "zip":
@@ -212,6 +237,8 @@ def _repr(v):
     runs, its own repr)."""
     if isinstance(v, Table):
         return repr(v.key)
+    if isinstance(v, Unread):
+        return repr(v.text)
     return repr(v) if isinstance(v, str) else repr(float(v))
 
 
@@ -221,10 +248,10 @@ def inline(v):
     return ";" in v or "\n" in v
 
 
-def _is_number(v):
+def _finite_text(v):
+    """Whether the text `v` is a finite number written as text ("20", not "nan")."""
     try:
-        float(v)
-        return True
+        return math.isfinite(float(v))
     except ValueError:
         return False
 
@@ -324,10 +351,19 @@ def _table(where, name, text):
 
 
 def _tables(name, values, base, cache):
-    """`values` with each text that is not a number read as a table (a number written
-    as text stays text: it is refused before anything runs, as a number for a table or
-    text for a number)."""
-    return [read_table(name, v, base, cache) if isinstance(v, str) and not _is_number(v) else v for v in values]
+    """`values` with each text read as a table (a path or the table written out, a
+    text that looks like a number too: a file may be named `20`); a text that is not
+    one is kept as :class:`Unread`, refused once the variable's type is known (as a
+    table's text for a String parameter, as text for one that takes a number)."""
+    out = []
+    for v in values:
+        if isinstance(v, str):
+            try:
+                v = dataclasses.replace(read_table(name, v, base, cache), given=v)
+            except ValueError as e:
+                v = Unread(v, str(e))
+        out.append(v)
+    return out
 
 
 def _number(where, v):
