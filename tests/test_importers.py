@@ -17,7 +17,7 @@ import ctypes
 
 import pytest
 
-from fmu_helpers import Log, unit
+from fmu_helpers import Log, initialised  # fmi2SetupExperiment without a stop time
 
 # fmi2Status
 OK, WARNING, DISCARD = 0, 1, 2
@@ -39,20 +39,10 @@ def warnings(log):
     return [m for s, _, m in log.records if s != OK]
 
 
-def started(paths, name, log, params=None):
-    """Instantiated, parameters set, initialised, fmi2SetupExperiment without a stop time."""
-    u = unit(paths, name, log)
-    u.fmu.setupExperiment(startTime=0.0)
-    u.set_parameters(params)
-    u.fmu.enterInitializationMode()
-    u.fmu.exitInitializationMode()
-    return u
-
-
 def test_the_c_fmusim_recipes_return_only_ok(paths):
     # CoupledSystem, fmusim's defaults: the DefaultExperiment's 0.8 s in steps of its 1e-4 s.
     log = Log()
-    cs = started(paths, "CoupledSystem", log)
+    cs = initialised(paths, "CoupledSystem", log)
     try:
         statuses = {do_step(cs, k * 1e-4, 1e-4) for k in range(8000)}
         assert statuses == {OK} and not warnings(log), warnings(log)[:3]
@@ -64,7 +54,7 @@ def test_the_c_fmusim_recipes_return_only_ok(paths):
     # status is the warning of the rail end's zone (which stops C fmusim), then the run
     # ends with fmi2Discard and fmi2Terminated, before any error.
     log = Log()
-    tc = started(paths, "TrackContact", log, {"track.window.ahead": 0.0})
+    tc = initialised(paths, "TrackContact", log, {"track.window.ahead": 0.0})
     try:
         h, k, seen = 1e-4, 0, []
         while k < 20000:
@@ -89,8 +79,8 @@ def shipped_pair_before_its_last_step(paths):
     """The shipped contact pair as OMSimulator runs it, 41,628 track steps (0.59999 s),
     the FMU states kept; yields (track, vehicle, log, the time, the step, the states)."""
     log = Log()
-    track = started(paths, "TrackContact", log, SHIPPED_TRACK)
-    vehicle = started(paths, "RollPlaneVehicle", log, SHIPPED_VEHICLE)
+    track = initialised(paths, "TrackContact", log, SHIPPED_TRACK)
+    vehicle = initialised(paths, "RollPlaneVehicle", log, SHIPPED_VEHICLE)
     try:
         h = track.get("solver.step")[0]
         n = int(0.6 / h)
