@@ -1,7 +1,7 @@
 //! A measured function of one variable: a table of points joined by straight lines,
 //! read from text (two numbers a line).
 
-use crate::error::{Error, Result, out_of_range};
+use crate::error::{Error, Result, num, out_of_range};
 
 /// Points `(x_i, y_i)` with strictly increasing `x`, at least two, every value finite;
 /// between points the straight line, beyond the ends the end values.
@@ -158,8 +158,8 @@ impl Table {
                         "{name}, points {} to {} (x = {} to {})",
                         i + 1,
                         j + 1,
-                        crate::error::num(x[i]),
-                        crate::error::num(x[j])
+                        num(x[i]),
+                        num(x[j])
                     ),
                     s,
                     format!("a slope of at most {max_slope:.4} either way ({limit})"),
@@ -184,7 +184,7 @@ impl Table {
                     &format!(
                         "{name}, point {} (change of slope at x = {})",
                         i + 1,
-                        crate::error::num(x[i])
+                        num(x[i])
                     ),
                     turn,
                     format!(

@@ -84,8 +84,8 @@ impl Scenario {
                 format!("1 to {MAX_WHEELSETS} wheelsets"),
             ));
         }
-        // Measured tables the contact could not follow: the rails' are checked as they
-        // are read; a wheel's needs the radius.
+        // Measured tables the contact could not follow (the FMUs check a rail's when it
+        // is set too; a wheel's needs the radius, known only here).
         for (side, rail) in ["left", "right"].iter().zip(&s.rails) {
             if let Some(t) = &rail.measured {
                 RailProfile::check_measured(t, &format!("rail.{side}.profile"))?;

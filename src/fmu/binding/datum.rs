@@ -142,7 +142,7 @@ impl InputDatum {
             // Between the first step and the second: a move of more than half the static
             // deflection from the first step's input is no partner at rest.
             for s in (0..2).filter(|&s| set[s]) {
-                let first = self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s]);
+                let first = self.first_input(k, s);
                 if (raw[s] - first).abs() > 0.5 * self.statics[k][s].abs() {
                     // Only a connector's initial 0 is taken for no input at all.
                     let again = first == 0.0;
@@ -157,6 +157,12 @@ impl InputDatum {
             }
         }
         [0, 1].map(|s| raw[s] + self.offsets[k][s])
+    }
+
+    /// Wheelset `k`'s input on side `s` at the first step (m): kept where the datum was
+    /// taken again or a move from it warned of, else what the offset was fixed from.
+    fn first_input(&self, k: usize, s: usize) -> f64 {
+        self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s])
     }
 
     /// The warning for the datum taken again since the last call (`axle_box`: the
@@ -211,11 +217,10 @@ impl InputDatum {
                 self.fixed[k] && self.offsets[k][s].abs() > 0.5 * self.statics[k][s].abs()
             })
             .map(|(k, s)| {
-                let first = self.retaken[k][s].unwrap_or(self.statics[k][s] - self.offsets[k][s]);
                 format!(
                     "{} was {} at the first step, taken for its static {} (offset {})",
                     input_name(axle_box, k, s),
-                    mm(first),
+                    mm(self.first_input(k, s)),
                     mm(self.statics[k][s]),
                     mm(self.offsets[k][s])
                 )

@@ -471,8 +471,8 @@ impl FmuModel {
             TrackSpec::Lumped(_) => f64::NAN,
         };
         Some(format!(
-            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track's running length (its last sleeper but one) at \
-             t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
+            "stopTime = {stop} s cannot be reached: the wheel reaches the end of the track's \
+             running length (its last sleeper but one) at t = {} s, where fmi2DoStep returns fmi2Discard; track.spans >= {spans} reaches \
              stopTime, and the endless track (track.window.ahead > 0, the default; 20 m is \
              the converged window) any stopTime",
             start + t_end

@@ -329,7 +329,8 @@ impl<M: Model> Instance<M> {
         let call = Call::SetString;
         self.check(call)?;
         let name = call.name();
-        for &r in vrs {
+        let mut contents = Vec::with_capacity(vrs.len());
+        for (&r, v) in vrs.iter().zip(vals) {
             let s = self.string_spec(name, r)?;
             if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
                 return self.refuse(
@@ -341,10 +342,6 @@ impl<M: Model> Instance<M> {
                     ),
                 );
             }
-        }
-        let mut contents = Vec::with_capacity(vrs.len());
-        for (&r, v) in vrs.iter().zip(vals) {
-            let s = self.string_spec(name, r)?;
             match M::read_string(s, v) {
                 Ok(c) => contents.push(c),
                 Err(e) => return self.refuse(Status::Error, format!("{name}: {e}")),
