@@ -399,7 +399,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
         def limit(case):
             return time_limit
     ready = time.perf_counter()
-    counts = run_study.counts = {"ok": 0, "failed": 0, "lost": 0, "again": 0}
+    counts = {"ok": 0, "failed": 0, "lost": 0, "again": 0}
     if total > have:
         if serial:
             _serial(todo, total - have, out_dir, runner_path, progress, limit, counts)
