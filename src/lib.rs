@@ -15,11 +15,12 @@
 //! - [`wheel`]: the wheel radius with flats, placed by the axle rotation (2.9-2.21);
 //! - [`contact`]: the normal contact laws, adaptive and Hertz (2.5-2.8, 2.22-2.26, 1.3);
 //! - [`track`]: two Timoshenko rails on sleepers, pads and ballast (3.4-3.23);
-//! - [`vehicle`]: the roll-plane vehicle and the chapter-2 lumped models (3.1-3.3, 2.27);
+//! - [`vehicle`]: the roll-plane vehicle and the chapter-2 lumped models (3.1-3.3, 2.27),
+//!   and the vehicles on several wheelsets (the half-car bogie, the wagons);
 //! - [`sim`]: scenarios (the thesis' parameter sets), the coupled simulation and the
 //!   co-simulation units;
 //! - [`fmu`]: the FMI 2.0 co-simulation units (a model-independent FMI layer, the
-//!   binding of the three models, the C boundary).
+//!   binding of the models behind the FMUs listed in [`fmu::Kind`], the C boundary).
 
 // Index loops over the two wheels/rails mirror the equations' subscripts.
 #![allow(clippy::needless_range_loop)]

@@ -4,11 +4,6 @@ use super::law::{ContactLaw, ContactState};
 use super::perfect::patch_angle;
 use crate::wheel::WheelProfile;
 
-/// Hertz contact `P = C_H (delta_c - f_0)^(3/2)` (1.3) with the coefficient `C_H`
-/// (N/m^1.5) of `law`, for a wheel with profile `wheel` at axle rotation `gamma` (rad)
-/// and overlap `overlap` (m); `f_0` is the radius reduction under the wheel centre
-/// (`alpha = 0`). The patch reported is that of the nominal circle pressed in by
-/// `delta_c - f_0` (2.6).
 /// The Hertz law's contact stiffness `dP / d delta = 3/2 C_H d^(1/2)` (N/m), `d` the
 /// overlap less the radius reduction under the wheel centre; 0 out of contact.
 pub(super) fn hertz_stiffness(
@@ -25,6 +20,11 @@ pub(super) fn hertz_stiffness(
     }
 }
 
+/// Hertz contact `P = C_H (delta_c - f_0)^(3/2)` (1.3) with the coefficient `C_H`
+/// (N/m^1.5) of `law`, for a wheel with profile `wheel` at axle rotation `gamma` (rad)
+/// and overlap `overlap` (m); `f_0` is the radius reduction under the wheel centre
+/// (`alpha = 0`). The patch reported is that of the nominal circle pressed in by
+/// `delta_c - f_0` (2.6).
 pub(super) fn hertz(
     law: &ContactLaw,
     wheel: &WheelProfile,

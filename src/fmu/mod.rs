@@ -1,11 +1,12 @@
 //! The FMI 2.0 co-simulation units: [`fmi2`], a model-independent FMI layer (state
 //! machine, value access through the variable table, clock, FMU states, logging);
-//! [`binding`], this project's three models behind it; [`ffi`], the thin C boundary
-//! that only converts pointers, catches panics and forwards; and [`vars`], the
-//! variable table generated from `modelDescription/variables.xml`.
+//! [`binding`], this project's models behind it, one for each FMU listed in [`Kind`];
+//! [`ffi`], the thin C boundary that only converts pointers, catches panics and
+//! forwards; and [`vars`], the variable table generated from
+//! `modelDescription/variables.xml`.
 //!
-//! Three FMUs share one shared library; `fmi2Instantiate` picks the model from the
-//! GUID, which identifies exactly one of them.
+//! The FMUs share one shared library; `fmi2Instantiate` picks the model from the GUID,
+//! which identifies exactly one of them.
 
 pub mod binding;
 pub mod ffi;

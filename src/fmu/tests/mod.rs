@@ -4,7 +4,10 @@
 
 mod bounds;
 mod clock;
+mod fmu_states;
 mod machine;
+mod start;
+mod tables;
 
 pub(super) use crate::fmu::fmi2::{ALL, MAGIC};
 pub(super) use crate::fmu::vars::{self, Causality, VarType, vr};
