@@ -184,6 +184,14 @@ pub struct SideFrameInertia {
 }
 
 impl SideFrameInertia {
+    /// Nothing above the axle boxes that the track moves on: the suspension's upper
+    /// ends go on at the velocity they came in with over a communication step (the
+    /// two-axle wagon, whose car body there is slow beside the exchange).
+    pub const NONE: SideFrameInertia = SideFrameInertia {
+        direct: 0.0,
+        cross: 0.0,
+    };
+
     /// A side frame of mass `mass` (kg) over one wheelset's axle box, bounce only (the
     /// roll-plane vehicle, (3.1)).
     pub fn single(mass: f64) -> SideFrameInertia {
@@ -279,14 +287,16 @@ impl PrimaryLink {
     pub fn new(p: &RollPlaneParams, dt: f64, inertia: SideFrameInertia) -> Result<PrimaryLink> {
         crate::limits::check("vehicle.primary.stiffness", p.primary_stiffness)?;
         crate::limits::check("vehicle.primary.damping", p.primary_damping)?;
-        if !(inertia.direct.is_finite()
-            && inertia.direct > 0.0
-            && inertia.cross.abs() < inertia.direct)
+        if !(inertia == SideFrameInertia::NONE
+            || inertia.direct.is_finite()
+                && inertia.direct > 0.0
+                && inertia.cross.abs() < inertia.direct)
         {
             return Err(out_of_range(
                 "side frame mobility",
                 inertia.direct,
-                "a positive direct mobility 1/m + l^2/J above the cross mobility's magnitude",
+                "a positive direct mobility 1/m + l^2/J above the cross mobility's magnitude, \
+                 or none",
             ));
         }
         Ok(PrimaryLink {

@@ -16,6 +16,9 @@
 //! and dampers. Measured against the whole model on the track
 //! (`examples/axle_box_masters.rs --limits`) it is in docs/VALIDATION.md.
 
+use super::MAX_AXLES;
+use super::linear_body::{LinearVehicle, SprungLinearBody};
+use super::rail_vehicle::{Axles, SprungVehicle};
 use super::{
     HalfCarParams, PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie, SprungHalfCar,
 };
@@ -138,6 +141,58 @@ impl TrackSide {
             self.links[1].set_partner_force(a);
         }
     }
+}
+
+impl<P, const N: usize, const S: usize> SprungBody for SprungLinearBody<P, N, S>
+where
+    P: LinearVehicle<N, S>,
+{
+    fn boxes(&self) -> usize {
+        2 * P::WHEELSETS
+    }
+    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
+        let (z, v) = SprungVehicle::side_frames(self);
+        let n = P::WHEELSETS;
+        (z[..n].concat(), v[..n].concat())
+    }
+    fn step_boxes(&mut self, f: &[f64]) {
+        let mut a = [[0.0; 2]; MAX_AXLES];
+        for (w, aw) in a.iter_mut().enumerate().take(P::WHEELSETS) {
+            *aw = [f[2 * w], f[2 * w + 1]];
+        }
+        SprungLinearBody::step_boxes(self, &a);
+    }
+    fn state(&self) -> Vec<f64> {
+        self.integrator_state()
+    }
+    fn set_state(&mut self, v: &[f64]) {
+        self.set_integrator_displacements(v);
+    }
+    fn set_step(&mut self, dt: f64) {
+        self.set_substep(dt);
+    }
+}
+
+/// [`ExchangeLimits`] of the linear vehicle `body` above its primary suspension, at rest
+/// with its axle boxes at `z` (m), substeps of at most `base` (s), its wheelsets
+/// (`wheelset`: their mass, inertia and primary suspension) on contact springs of
+/// `support` (N/m per wheel), the track carrying `inertia` above each axle box.
+///
+/// Errors: a parameter [`PrimaryLink::new`] refuses.
+pub(super) fn linear_limits<P, const N: usize, const S: usize>(
+    body: &SprungLinearBody<P, N, S>,
+    wheelset: &RollPlaneParams,
+    inertia: SideFrameInertia,
+    z: &Axles,
+    base: f64,
+    support: f64,
+) -> Result<ExchangeLimits>
+where
+    P: LinearVehicle<N, S>,
+{
+    let z_box = z[..P::WHEELSETS].concat();
+    let track = track_side(body, wheelset, inertia, &z_box, support)?;
+    Ok(limits_of(body, &track, base))
 }
 
 /// The amplification matrix of one communication step `h` (s) of the exchange about the

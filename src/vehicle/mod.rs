@@ -26,12 +26,14 @@ mod axle_box;
 mod exchange;
 mod half_car;
 mod half_car_bogie;
+mod linear_body;
 mod lumped;
 mod rail_vehicle;
 mod roll_plane;
 mod sprung_bogie;
 #[cfg(test)]
 mod tests;
+mod two_axle;
 mod wagon;
 mod wagon_motion;
 #[cfg(test)]
@@ -43,9 +45,11 @@ pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
 };
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
+pub use linear_body::{LinearBody, LinearVehicle, SprungLinearBody};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use rail_vehicle::{Axles, Bodies, CarrierModel, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
+pub use two_axle::{SprungTwoAxleWagon, TWO_AXLE_DOFS, TwoAxleParams, TwoAxleWagon};
 pub use wagon::{MIN_BOGIE_GAP, WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
 pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};
