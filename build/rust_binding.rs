@@ -53,6 +53,16 @@ pub fn write(table: &Table, guids: &[String]) -> String {
         .unwrap();
     }
     writeln!(rust, "}}\n").unwrap();
+    writeln!(
+        rust,
+        "/// Every variable's name, in value reference order.\n\
+         pub static NAMES: [&str; N_VR] = {:?};\n\n\
+         /// The value reference of the variable `name`.\n\
+         pub fn vr_of(name: &str) -> Option<u32> {{\n    \
+         NAMES.iter().position(|n| *n == name).map(|i| i as u32)\n}}\n",
+        table.vars.iter().map(|v| v.name()).collect::<Vec<_>>()
+    )
+    .unwrap();
     enumerations(&mut rust, table);
     flat_vrs(&mut rust, table);
     wheelset_vrs(&mut rust, table);
@@ -80,6 +90,22 @@ pub fn write(table: &Table, guids: &[String]) -> String {
         }
         writeln!(rust, "    ],\n}};\n").unwrap();
     }
+    writeln!(
+        rust,
+        "/// Every FMU's table, in the order of the table's `<Fmu>` elements.\n\
+         pub static FMUS: [&FmuTable; {}] = [{}];\n\n\
+         /// The table of the FMU `model_identifier`.\n\
+         pub fn fmu_table(model_identifier: &str) -> Option<&'static FmuTable> {{\n    \
+         FMUS.into_iter().find(|t| t.model_identifier == model_identifier)\n}}\n",
+        table.fmus.len(),
+        table
+            .fmus
+            .iter()
+            .map(|f| format!("&{}", split_camel(f.id(), true)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+    .unwrap();
     writeln!(
         rust,
         "/// docs/VARIABLES.md as the table generates it.\n\
@@ -114,6 +140,21 @@ fn enumerations(rust: &mut String, table: &Table) {
             )
             .unwrap();
         }
+        writeln!(
+            rust,
+            "        /// Every item `(name, value)`.\n        \
+             pub const ITEMS: [(&str, f64); {}] = [{}];\n        \
+             /// The name of the item of `value`, if one has it.\n        \
+             pub fn item(value: f64) -> Option<&'static str> {{\n            \
+             ITEMS.iter().find(|(_, v)| *v == value).map(|(n, _)| *n)\n        }}",
+            items.len(),
+            items
+                .iter()
+                .map(|x| format!("({:?}, {}.0)", x.name, x.value))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+        .unwrap();
         writeln!(rust, "    }}").unwrap();
     }
     writeln!(rust, "}}\n").unwrap();

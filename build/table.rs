@@ -118,6 +118,7 @@ pub struct Table {
 impl Table {
     /// Reads the table; panics naming what is wrong with it.
     pub fn read(text: &str) -> Table {
+        let groups = groups(text);
         let mut reader = Reader::from_str(text);
         let mut fmus: Vec<Attrs> = Vec::new();
         let mut vars: Vec<TableVar> = Vec::new();
@@ -168,14 +169,14 @@ impl Table {
                         for (k, l) in &lists {
                             b = b.replace(&format!("{{{k}}}"), &l[i]);
                         }
-                        read_variables(&mut Reader::from_str(&b), &mut vars);
+                        read_variables(&mut Reader::from_str(&b), &mut vars, &groups);
                     }
                 }
                 Event::Start(e) | Event::Empty(e) if e.name().as_ref() == "Variable" => {
-                    variable_event(&e, &mut vars);
+                    variable_event(&e, &mut vars, &groups);
                 }
                 Event::Empty(e) if e.name().as_ref() == "Override" => {
-                    variable_event(&e, &mut vars);
+                    variable_event(&e, &mut vars, &groups);
                 }
                 _ => {}
             }
@@ -222,11 +223,73 @@ impl Table {
     }
 }
 
+/// The FMU groups a `fmus` list may name as `@name`: each `<Group name fmus>` of the
+/// table, `@vehicles` (every `<Fmu>` with a `vehicle` attribute: a kind of vehicle's own
+/// FMU) and `@axles2` to `@axles4` (those on at least that many wheelsets, their
+/// `wheelsets` attribute).
+fn groups(text: &str) -> BTreeMap<String, String> {
+    let mut groups = BTreeMap::new();
+    let mut vehicles: Vec<(String, usize)> = Vec::new();
+    let mut r = Reader::from_str(text);
+    loop {
+        match r.read_event().expect("well-formed variable table") {
+            Event::Eof => break,
+            Event::Empty(e) if e.name().as_ref() == "Group" => {
+                let a = attrs(&e);
+                groups.insert(format!("@{}", a["name"]), a["fmus"].clone());
+            }
+            Event::Empty(e) if e.name().as_ref() == "Fmu" => {
+                let a = attrs(&e);
+                if a.contains_key("vehicle") {
+                    let n = a["wheelsets"]
+                        .parse()
+                        .expect("an Fmu's wheelsets is a count");
+                    vehicles.push((a["modelIdentifier"].clone(), n));
+                }
+            }
+            _ => {}
+        }
+    }
+    let of = |least: usize| {
+        vehicles
+            .iter()
+            .filter(|(_, n)| *n >= least)
+            .map(|(id, _)| id.as_str())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    groups.insert("@vehicles".into(), of(1));
+    for k in 2..=4 {
+        groups.insert(format!("@axles{k}"), of(k));
+    }
+    groups
+}
+
+/// `list` with every `@group` replaced by its FMUs.
+fn expand(list: &str, groups: &BTreeMap<String, String>) -> String {
+    list.split_whitespace()
+        .map(|x| {
+            if x.starts_with('@') {
+                groups
+                    .get(x)
+                    .unwrap_or_else(|| panic!("no FMU group {x}"))
+                    .clone()
+            } else {
+                x.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// A `<Variable>` (a new variable) or `<Override>` (of the last one) element.
-fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>) {
+fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>, groups: &BTreeMap<String, String>) {
     if e.name().as_ref() == "Variable" {
+        let mut attrs = attrs(e);
+        let fmus = expand(&attrs["fmus"], groups);
+        attrs.insert("fmus".into(), fmus);
         vars.push(TableVar {
-            attrs: attrs(e),
+            attrs,
             overrides: BTreeMap::new(),
         });
     } else {
@@ -234,7 +297,7 @@ fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>) {
         // the later attribute winning.
         let mut a = attrs(e);
         // (An empty list, a Repeat item `-`, overrides nothing.)
-        let fmus = a.remove("fmu").expect("Override needs fmu=");
+        let fmus = expand(&a.remove("fmu").expect("Override needs fmu="), groups);
         let var = vars.last_mut().expect("Override inside a Variable");
         for fmu in fmus.split_whitespace() {
             var.overrides
@@ -246,14 +309,18 @@ fn variable_event(e: &BytesStart, vars: &mut Vec<TableVar>) {
 }
 
 /// The variables of a `<Repeat>` body, in order.
-fn read_variables(reader: &mut Reader<&[u8]>, vars: &mut Vec<TableVar>) {
+fn read_variables(
+    reader: &mut Reader<&[u8]>,
+    vars: &mut Vec<TableVar>,
+    groups: &BTreeMap<String, String>,
+) {
     loop {
         match reader.read_event().expect("well-formed Repeat body") {
             Event::Eof => break,
             Event::Start(e) | Event::Empty(e)
                 if matches!(e.name().as_ref(), "Variable" | "Override") =>
             {
-                variable_event(&e, vars);
+                variable_event(&e, vars, groups);
             }
             _ => {}
         }

@@ -19,7 +19,6 @@ from setuptools.command.build_py import build_py
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
 
 
 def cargo_version():
@@ -42,13 +41,20 @@ def built():
         sys.exit(f"building the wheelflat wheel: {wf.BUILD_SCRIPT} failed ({e}); it needs bash, Rust's cargo "
                  "(https://rustup.rs), pip and binutils")
     needed = set()
-    for path in [wf.RUNNER_228] + [paths[n] for n in FMUS]:
+    for path in [wf.RUNNER_228] + list(paths.values()):
         needed |= wf.glibc_versions(path)
     newest = max(needed)
     if newest > wf.GLIBC_BASELINE:
         sys.exit(f"the wheel's runner or FMUs need glibc {'.'.join(map(str, newest))}, above the baseline "
                  f"{'.'.join(map(str, wf.GLIBC_BASELINE))}")
     return wf.RUNNER_228, wf.FMU_DIR, ".".join(map(str, newest))
+
+
+def wf_registry(fmu_dir):
+    """The packer's list of the FMUs and the vehicle registry beside them."""
+    import json
+    with open(os.path.join(fmu_dir, "fmus.json")) as fh:
+        return json.load(fh)
 
 
 class build_with_runner(build_py):
@@ -65,7 +71,9 @@ class build_with_runner(build_py):
         dest = os.path.join(data, "bin", "wheelflat_case")
         shutil.copyfile(runner, dest)
         os.chmod(dest, 0o755)
-        for name in FMUS:
+        # The FMUs and the vehicle registry (fmus.json) the packer wrote.
+        shutil.copyfile(os.path.join(fmu_dir, "fmus.json"), os.path.join(data, "fmu", "fmus.json"))
+        for name in wf_registry(fmu_dir)["fmus"]:
             shutil.copyfile(os.path.join(fmu_dir, name + ".fmu"), os.path.join(data, "fmu", name + ".fmu"))
         import json
         info = collect(dest, os.path.join(data, "fmu"), ROOT)

@@ -10,6 +10,7 @@ Then each communication point: vehicle outputs -> track inputs -> track outputs 
 vehicle inputs -> both step.
 """
 
+import json
 import os
 import re
 import subprocess
@@ -26,7 +27,20 @@ VENV = os.path.join(ROOT, ".venv")
 REQUIREMENTS = os.path.join(ROOT, "python", "requirements.txt")
 FMU_DIR = os.path.join(ROOT, "fmu") if CHECKOUT else \
     os.path.join(os.path.dirname(os.path.abspath(__file__)), "wheelflat_study", "_data", "fmu")
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
+
+
+def registry(fmu_dir=None):
+    """The FMUs and the vehicle registry (src/vehicle/registry.rs) as the packer wrote
+    them beside the FMUs (``fmus.json``): ``{"fmus": [model identifiers], "vehicles":
+    [{"fmu", "item", "value", "wheelsets", "offsets"}]}``, each offset of a wheelset
+    behind the leading one the sum of those parameters of the vehicle's FMU."""
+    with open(os.path.join(fmu_dir or FMU_DIR, "fmus.json")) as fh:
+        return json.load(fh)
+
+
+def vehicle_kind(fmu, fmu_dir=None):
+    """The registry's entry of the vehicle FMU `fmu`."""
+    return next(k for k in registry(fmu_dir)["vehicles"] if k["fmu"] == fmu)
 # Cargo's build directory: $CARGO_TARGET_DIR when set (relative to the repository), else target/.
 TARGET_DIR = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target")
 # The one build of the FMUs, shared by the README's main command (build_fmus below), the
@@ -71,10 +85,9 @@ def build_fmus():
     through scripts/build_fmus_glibc228.sh (cargo-zigbuild, release profile; cargo's
     progress on stderr, the packer's list dropped); the FMUs by name. Installed from the
     wheel: the FMUs that came with it, built the same way."""
-    if not CHECKOUT:
-        return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
-    subprocess.check_call(["bash", BUILD_SCRIPT, FMU_DIR], cwd=ROOT, stdout=subprocess.DEVNULL)
-    return {name: os.path.join(FMU_DIR, name + ".fmu") for name in FMUS}
+    if CHECKOUT:
+        subprocess.check_call(["bash", BUILD_SCRIPT, FMU_DIR], cwd=ROOT, stdout=subprocess.DEVNULL)
+    return {name: os.path.join(FMU_DIR, name + ".fmu") for name in registry()["fmus"]}
 
 
 def glibc_versions(path):
@@ -104,6 +117,7 @@ class Unit:
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
+        self.path = path
         self.md = read_model_description(path)
         self.owns_dir = unzip_dir is None
         self.dir = extract(path) if unzip_dir is None else unzip_dir
@@ -329,12 +343,12 @@ HEIGHTS = ("static_wheel_z.left", "static_wheel_z.right")
 
 def carrier_handshake(track, vehicle, n, track_params, vehicle_params):
     """Parameters and the static handshake of TrackContact carrying the `n` wheelsets of
-    a vehicle (RollPlaneVehicle: 1, HalfCarBogie: 2, Wagon: 4): its static loads to the
+    a vehicle (its registry entry's, :func:`vehicle_kind`): its static loads to the
     track, every wheelset's static wheel heights back; both left in initialization
-    mode. With several wheelsets TrackContact's offsets are the vehicle's:
-    ``wheelset[2].offset`` its ``vehicle.wheelbase``, and for the Wagon
-    ``wheelset[3].offset`` its ``vehicle.bogie_distance`` and ``wheelset[4].offset``
-    their sum."""
+    mode. With several wheelsets TrackContact's offsets are the vehicle's (each the sum
+    of the parameters its registry entry names: the HalfCarBogie's
+    ``vehicle.wheelbase``; the Wagon's, its ``vehicle.bogie_distance`` and their sum;
+    the TwoAxleWagon's ``wheelset[2].offset``)."""
     vp = dict(vehicle_params or {})
     tp = dict(track_params or {})
     for u in (track, vehicle):
@@ -342,11 +356,10 @@ def carrier_handshake(track, vehicle, n, track_params, vehicle_params):
     vehicle.set_parameters(vp)
     if n > 1:
         start = {v.name: v.start for v in vehicle.md.modelVariables}
-        a = float(vp.get("vehicle.wheelbase", start["vehicle.wheelbase"]))
-        tp.update({"wheelsets": n, "wheelset[2].offset": a})
-        if n == 4:
-            d = float(vp.get("vehicle.bogie_distance", start["vehicle.bogie_distance"]))
-            tp.update({"wheelset[3].offset": d, "wheelset[4].offset": d + a})
+        kind = vehicle_kind(vehicle.md.coSimulation.modelIdentifier, os.path.dirname(vehicle.path))
+        tp["wheelsets"] = n
+        for k, names in enumerate(kind["offsets"], start=2):
+            tp[f"wheelset[{k}].offset"] = sum(float(vp.get(x, start[x])) for x in names)
     track.set_parameters(tp)
     vehicle.fmu.enterInitializationMode()
     track.fmu.enterInitializationMode()
@@ -435,9 +448,10 @@ def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_param
     axle_box = every_wheelset(n, AXLE_BOX)
     forces = every_wheelset(n, FORCES)
     try:
-        # vehicle.model = half_car or wagon: the track carries the bogies' pitching side
-        # frames, each shared by two wheelsets, over each step.
-        carrier_handshake(track, vehicle, n, dict(track_params or {}, interface=2, **{"vehicle.model": n // 2 + 1}),
+        # vehicle.model of the vehicle's kind: what the track carries above the axle boxes
+        # (the bogies' pitching side frames, or nothing for the two-axle wagon).
+        value = vehicle_kind(model, os.path.dirname(paths[model]))["value"]
+        carrier_handshake(track, vehicle, n, dict(track_params or {}, interface=2, **{"vehicle.model": value}),
                           dict(vehicle_params or {}, interface=2))
         vehicle.fmu.exitInitializationMode()
         track.fmu.exitInitializationMode()
@@ -465,6 +479,18 @@ def run_half_car_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, b
 def run_wagon_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, wagon_params=None, record=None):
     """:func:`run_carrier_axle_box` of the Wagon (four wheelsets)."""
     return run_carrier_axle_box(paths, "Wagon", 4, stop_time, comm_step, track_params, wagon_params, record)
+
+
+
+def run_two_axle(paths, stop_time, track_params=None, wagon_params=None, record=None):
+    """:func:`run_carrier` of the TwoAxleWagon: CoupledSystem with ``vehicle.model`` =
+    two_axle, exchanged at every step."""
+    return run_carrier(paths, "TwoAxleWagon", 2, stop_time, track_params, wagon_params, record)
+
+
+def run_two_axle_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, wagon_params=None, record=None):
+    """:func:`run_carrier_axle_box` of the TwoAxleWagon."""
+    return run_carrier_axle_box(paths, "TwoAxleWagon", 2, stop_time, comm_step, track_params, wagon_params, record)
 
 
 if __name__ == "__main__":

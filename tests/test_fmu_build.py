@@ -23,7 +23,7 @@ def test_the_main_command_leaves_fmus_that_need_no_glibc_symbol_version_above_2_
     assert r.returncode == 0, r.stdout + r.stderr
     assert "peak contact force, left wheel" in r.stdout
     libraries = {}
-    for name in wf.FMUS:
+    for name in wf.registry()["fmus"]:
         path = os.path.join(wf.FMU_DIR, name + ".fmu")
         # Packed by this run, not left from an earlier one (1 s for coarse timestamps).
         assert os.path.getmtime(path) >= start - 1, f"{path} was not packed by the main command"

@@ -27,7 +27,19 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FMU_DIR = os.path.join(ROOT, "fmu")
 SYSTEMS = os.path.join(FMU_DIR, "systems")
-VEHICLES = {"RollPlaneVehicle": 1, "HalfCarBogie": 2, "Wagon": 4}
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import wheelflat_fmus as wf  # noqa: E402
+
+
+def registry():
+    """The vehicle registry as the packer wrote it beside the FMUs (fmu/fmus.json)."""
+    if not os.path.exists(os.path.join(FMU_DIR, "fmus.json")):
+        wf.build_fmus()
+    return {k["fmu"]: k for k in wf.registry(FMU_DIR)["vehicles"]}
+
+
+# Every kind of vehicle's FMU and its wheelsets, from the registry.
+VEHICLES = {name: k["wheelsets"] for name, k in registry().items()}
 STOP = 0.6
 # The first impact is at about 34 ms; the start is checked before it.
 EARLY = 0.02
@@ -194,7 +206,7 @@ def monolithic(vehicle):
 
     n = VEHICLES[vehicle]
     out = wheel_names(n, "max_force") + ["position"]
-    r = simulate_fmu(os.path.join(FMU_DIR, "CoupledSystem.fmu"), stop_time=STOP, start_values=coupled_params(n),
+    r = simulate_fmu(os.path.join(FMU_DIR, "CoupledSystem.fmu"), stop_time=STOP, start_values=coupled_params(vehicle),
                      output=out, output_interval=1e-3)
     return dict(peaks=[float(r[x][-1]) for x in out[:-1]], position=float(r["position"][-1]))
 
@@ -207,17 +219,23 @@ def monolithic_start(vehicle, h):
     n = VEHICLES[vehicle]
     out = wheel_names(n, "force")
     r = simulate_fmu(os.path.join(FMU_DIR, "CoupledSystem.fmu"), stop_time=EARLY + 2 * h,
-                     start_values=coupled_params(n), output=out, output_interval=h)
+                     start_values=coupled_params(vehicle), output=out, output_interval=h)
     return list(r["time"]), {x: list(r[x]) for x in out}
 
 
-def coupled_params(n):
-    # vehicle.model: 1 roll_plane, 2 half_car, 3 wagon.
-    p = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "vehicle.model": {1: 1, 2: 2, 4: 3}[n]}
-    if n >= 2:
-        p.update({"wheelsets": n, "wheelset[2].offset": 1.8})
-    if n == 4:
-        p.update({"wheelset[3].offset": 10.0, "wheelset[4].offset": 11.8})
+def coupled_params(vehicle):
+    """CoupledSystem's parameters for the vehicle FMU `vehicle` at its defaults: its
+    registry entry's vehicle.model, its wheelsets at the offsets its own parameters give."""
+    from fmpy import read_model_description
+
+    kind = registry()[vehicle]
+    p = {"track.window.ahead": 20.0, "track.window.behind": 20.0, "vehicle.model": kind["value"]}
+    if kind["wheelsets"] > 1:
+        md = read_model_description(os.path.join(FMU_DIR, vehicle + ".fmu"))
+        start = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
+        p["wheelsets"] = kind["wheelsets"]
+        for k, names in enumerate(kind["offsets"], start=2):
+            p[f"wheelset[{k}].offset"] = sum(start[x] for x in names)
     return p
 
 
@@ -260,7 +278,7 @@ def test_shipped_steps(vehicle):
     import wheelflat_fmus as wf
 
     assert shipped_step(vehicle, "axle_box") == 1e-3
-    params = dict(coupled_params(VEHICLES[vehicle]), interface=1)
+    params = dict(coupled_params(vehicle), interface=1)
     h = wf.track_step({"TrackContact": os.path.join(FMU_DIR, "TrackContact.fmu")}, params)
     assert shipped_step(vehicle, "contact") == h
     osp = open(os.path.join(SYSTEMS, system_name(vehicle, "contact"), "OspSystemStructure.xml")).read()

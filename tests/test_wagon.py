@@ -28,7 +28,7 @@ STATIC_LOAD = 107664.75
 
 @pytest.fixture(scope="module")
 def paths():
-    p = {n: os.path.join(wf.FMU_DIR, n + ".fmu") for n in wf.FMUS}
+    p = {n: os.path.join(wf.FMU_DIR, n + ".fmu") for n in wf.registry()["fmus"]}
     if not all(os.path.exists(x) for x in p.values()):
         p = wf.build_fmus()
     return p

@@ -25,12 +25,12 @@ from .run import DATA, ROOT, default_runner, installed
 
 
 def fmu_paths():
-    """The five FMUs by name (TrackContact, RollPlaneVehicle, CoupledSystem,
-    HalfCarBogie, Wagon): the installed package's, or in a checkout those in fmu/ (built by
-    ``bash scripts/build_fmus_glibc228.sh fmu``, the portable build the main command makes)."""
-    from .buildinfo import FMUS
+    """The FMUs by name (those the packer listed in ``fmus.json``): the installed
+    package's, or in a checkout those in fmu/ (built by ``bash
+    scripts/build_fmus_glibc228.sh fmu``, the portable build the main command makes)."""
+    from .buildinfo import fmu_names
     where = os.path.join(DATA, "fmu") if installed() else os.path.join(ROOT, "fmu")
-    return {name: os.path.join(where, name + ".fmu") for name in FMUS}
+    return {name: os.path.join(where, name + ".fmu") for name in fmu_names(where)}
 
 
 def build_info():

@@ -10,7 +10,12 @@ import subprocess
 import xml.etree.ElementTree as ET
 import zipfile
 
-FMUS = ("TrackContact", "RollPlaneVehicle", "CoupledSystem", "HalfCarBogie", "Wagon")
+
+
+def fmu_names(fmu_dir):
+    """The FMUs' model identifiers the packer listed beside them (``fmus.json``)."""
+    with open(os.path.join(fmu_dir, "fmus.json")) as fh:
+        return json.load(fh)["fmus"]
 
 
 def fmu_identity(path):
@@ -33,7 +38,7 @@ def collect(runner, fmu_dir, root=None):
     `root`: the checkout, for the git commit."""
     info = {"runner": runner_identity(runner), "fmus": {}}
     info["version"] = info["runner"]["version"]
-    for name in FMUS:
+    for name in fmu_names(fmu_dir):
         path = os.path.join(fmu_dir, name + ".fmu")
         if os.path.isfile(path):
             info["fmus"][name] = fmu_identity(path)

@@ -290,9 +290,7 @@ impl Simulation {
                     rates: InputRates::default(),
                 },
                 // A vehicle on several wheelsets ([`VehicleSpec::carrier`]) moves them.
-                VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
-                    VehicleState::OnBogie { wheel_z: [0.0; 2] }
-                }
+                VehicleSpec::Carrier(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
             })
         };
         let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?

@@ -14,7 +14,9 @@ use super::scenario::{
 };
 use crate::contact::ContactModel;
 use crate::track::{RailBetweenNodes, RailEnds, RailSection, Supports, TrackParams};
-use crate::vehicle::{LumpedTrackParams, LumpedWheelParams, RollPlaneParams, WagonParams};
+use crate::vehicle::{
+    CarrierSpec, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, WagonParams,
+};
 use crate::wheel::FlatSpec;
 
 /// The track of tables 4.1 and 4.4 with `spans` sleeper spans at the default grid.
@@ -100,7 +102,9 @@ impl Scenario {
         let VehicleSpec::RollPlane(p) = s.vehicle else {
             unreachable!("table 4.4 has the roll-plane vehicle")
         };
-        s.vehicle = VehicleSpec::Wagon(WagonParams::table_4_4(&p, 10.0, 1.8, 180.0));
+        s.vehicle = VehicleSpec::Carrier(CarrierSpec::Wagon(WagonParams::table_4_4(
+            &p, 10.0, 1.8, 180.0,
+        )));
         s.trailing = [1.8, 10.0, 11.8]
             .map(|offset| TrailingWheelset {
                 offset,

@@ -7,8 +7,7 @@ use crate::contact::ContactModel;
 use crate::track::RailProfile;
 use crate::track::{RailBetweenNodes, Supports, TrackParams};
 use crate::vehicle::{
-    HalfCarParams, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
-    WagonParams,
+    CarrierSpec, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
 };
 use crate::wheel::{FlatSpec, OutOfRoundness};
 use std::sync::Arc;
@@ -27,14 +26,12 @@ pub enum TrackSpec {
 pub enum VehicleSpec {
     /// The six-DOF roll-plane vehicle (chapter 3).
     RollPlane(RollPlaneParams),
-    /// The half-car bogie (thesis figure 1.10, [`crate::vehicle::HalfCarBogie`]) on
-    /// two wheelsets: the leading one and one trailing wheelset at the bogie's
-    /// wheelbase ([`Scenario::trailing`]).
-    HalfCar(HalfCarParams),
-    /// The four-axle wagon ([`crate::vehicle::Wagon`]): the car body on two half-car
-    /// bogies, on four wheelsets at the offsets `a`, `d`, `d + a` (the bogies'
-    /// wheelbase `a`, their centre distance `d`).
-    Wagon(WagonParams),
+    /// A vehicle on several wheelsets, any kind of the registry
+    /// ([`crate::vehicle::VEHICLE_KINDS`]): the half-car bogie, the four-axle wagon, the
+    /// two-axle wagon, on the leading wheelset and the trailing ones
+    /// ([`Scenario::trailing`]) at the offsets its [`crate::vehicle::CarrierModel::offsets`]
+    /// name.
+    Carrier(CarrierSpec),
     /// The chapter-2 lumped wheel on each rail.
     LumpedWheels(LumpedWheelParams),
     /// A constant moving load on each rail `[left, right]` (N) (chapter 4).
@@ -69,12 +66,10 @@ pub enum VehicleSpec {
 
 impl VehicleSpec {
     /// The vehicle on several wheelsets, behind its interface; `None` for a vehicle or
-    /// load on each wheelset. The one place that names those kinds: a new one is an arm
-    /// here and its [`crate::vehicle::CarrierModel`] in its own file.
+    /// load on each wheelset.
     pub fn carrier(&self) -> Option<&dyn crate::vehicle::CarrierModel> {
         match self {
-            VehicleSpec::HalfCar(h) => Some(h),
-            VehicleSpec::Wagon(w) => Some(w),
+            VehicleSpec::Carrier(c) => Some(c.model()),
             _ => None,
         }
     }
@@ -327,6 +322,10 @@ pub enum SideFrameSpec {
         /// 2, the wagon's over 1 and 2 and over 3 and 4 (four wheelsets).
         bogies: usize,
     },
+    /// Nothing above the axle boxes ([`SideFrameInertia::NONE`]): the suspension's
+    /// upper ends go on at the velocity they came in with (the two-axle wagon's car
+    /// body).
+    Nothing,
 }
 
 impl SideFrameSpec {
@@ -339,6 +338,7 @@ impl SideFrameSpec {
     pub fn inertia(&self, s: &Scenario) -> crate::error::Result<(SideFrameInertia, bool)> {
         use crate::error::out_of_range;
         match *self {
+            SideFrameSpec::Nothing => Ok((SideFrameInertia::NONE, false)),
             SideFrameSpec::PerWheelset { mass } => {
                 crate::limits::check("vehicle.sideframe.mass", mass)?;
                 Ok((SideFrameInertia::single(mass), false))

@@ -27,10 +27,7 @@ pub(crate) const STATIC_LOAD_TOLERANCE: f64 = 1e-10;
 pub(crate) fn static_loads(vehicle: &VehicleSpec) -> Result<[f64; 2]> {
     Ok(match vehicle {
         VehicleSpec::RollPlane(p) => [p.static_wheel_load(); 2],
-        VehicleSpec::HalfCar(_) | VehicleSpec::Wagon(_) => {
-            let c = vehicle.carrier().expect("a vehicle on several wheelsets");
-            [c.static_wheel_load(); 2]
-        }
+        VehicleSpec::Carrier(c) => [c.model().static_wheel_load(); 2],
         VehicleSpec::AxleBox { static_load, .. } => {
             non_negative("static_load.left", static_load[0], "N")?;
             non_negative("static_load.right", static_load[1], "N")?;

@@ -16,8 +16,8 @@ use super::clock::{Clock, ForceExtremes, Stepping};
 use crate::error::{Result, finite, non_negative, num, out_of_range};
 use crate::limits::{MIN_DT_FRACTION, check};
 use crate::vehicle::{
-    Axles, Bodies, CONTACT_STIFFNESS, CarrierModel, ExchangeLimits, HalfCarParams, MAX_AXLES,
-    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungVehicle, WagonParams,
+    Axles, Bodies, CONTACT_STIFFNESS, CarrierModel, CarrierSpec, ExchangeLimits, MAX_AXLES,
+    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungVehicle,
 };
 use nalgebra::Vector6;
 
@@ -64,22 +64,18 @@ impl VehicleUnitParams {
 pub enum UnitModel {
     /// The roll-plane vehicle ([`VehicleUnitParams::vehicle`]) on one wheelset.
     RollPlane,
-    /// The half-car bogie ([`HalfCarParams::from_roll_plane`] of the vehicle, with its
-    /// wheelbase and side frames' pitch inertia): two wheelsets.
-    HalfCar(HalfCarParams),
-    /// The wagon ([`WagonParams`]): four wheelsets.
-    Wagon(WagonParams),
+    /// A vehicle on several wheelsets, any kind of the registry
+    /// ([`crate::vehicle::VEHICLE_KINDS`]).
+    Carrier(CarrierSpec),
 }
 
 impl UnitModel {
     /// The vehicle on several wheelsets, behind its interface; `None` for the
-    /// roll-plane vehicle. The one place that names the kinds: a new vehicle on several
-    /// wheelsets is an arm here and its [`CarrierModel`] in its own file.
+    /// roll-plane vehicle.
     pub fn carrier(&self) -> Option<&dyn CarrierModel> {
         match self {
             UnitModel::RollPlane => None,
-            UnitModel::HalfCar(h) => Some(h),
-            UnitModel::Wagon(w) => Some(w),
+            UnitModel::Carrier(c) => Some(c.model()),
         }
     }
 
@@ -154,7 +150,10 @@ impl VehicleUnit {
         non_negative("solver.dt", p.dt, "s")?;
         check("static_wheel_z.left", p.static_wheel_z[0])?;
         check("static_wheel_z.right", p.static_wheel_z[1])?;
-        p.vehicle.validate()?;
+        // A vehicle on several wheelsets checks its own parameters below.
+        if p.model.carrier().is_none() {
+            p.vehicle.validate()?;
+        }
         let n = p.model.wheelsets();
         for (z, k) in p.trailing_static_wheel_z.iter().take(n - 1).zip(2..) {
             check(&format!("wheelset[{k}].static_wheel_z.left"), z[0])?;

@@ -29,6 +29,7 @@ mod half_car_bogie;
 mod linear_body;
 mod lumped;
 mod rail_vehicle;
+mod registry;
 mod roll_plane;
 mod sprung_bogie;
 #[cfg(test)]
@@ -48,6 +49,10 @@ pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use linear_body::{LinearBody, LinearVehicle, SprungLinearBody};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
 pub use rail_vehicle::{Axles, Bodies, CarrierModel, MAX_AXLES, RailVehicle, SprungVehicle};
+pub use registry::{
+    AboveAxleBoxes, CarrierSpec, VEHICLE_KINDS, Values, VehicleKind, kind_of_fmu, kind_of_item,
+    roll_plane,
+};
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
 pub use sprung_bogie::SprungBogie;
 pub use two_axle::{SprungTwoAxleWagon, TWO_AXLE_DOFS, TwoAxleParams, TwoAxleWagon};

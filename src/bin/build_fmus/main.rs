@@ -116,6 +116,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&doc, VARIABLES_MD)?;
         println!("{doc} (from the variable table)");
     }
+    std::fs::write(out.join("fmus.json"), registry_json())?;
     std::fs::create_dir_all(out.join("include"))?;
     std::fs::write(out.join("include/wheelflat_fmi2.h"), C_HEADER)?;
     for t in FMUS {
@@ -147,4 +148,45 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     }
     systems::write(&out)?;
     Ok(())
+}
+
+/// `fmus.json`, the FMUs and the vehicle registry for the Python helpers: every FMU's
+/// model identifier, and each kind of vehicle (its FMU, its `vehicle.model` item and
+/// value, its wheelsets, and the parameters of its FMU whose sums place the wheelsets
+/// behind the leading one).
+fn registry_json() -> String {
+    use wheelflat::fmu::vars::enums::vehicle_model;
+    let quote = |s: &str| format!("{s:?}");
+    let fmus: Vec<String> = FMUS.iter().map(|t| quote(t.model_identifier)).collect();
+    let vehicles: Vec<String> = wheelflat::vehicle::VEHICLE_KINDS
+        .iter()
+        .map(|k| {
+            let value = vehicle_model::ITEMS
+                .iter()
+                .find(|(n, _)| *n == k.item)
+                .expect("each kind is an item of VehicleModel")
+                .1;
+            let offsets: Vec<String> = k
+                .offsets
+                .iter()
+                .map(|names| {
+                    let n: Vec<String> = names.iter().map(|n| quote(n)).collect();
+                    format!("[{}]", n.join(", "))
+                })
+                .collect();
+            format!(
+                "  {{\"fmu\": {}, \"item\": {}, \"value\": {}, \"wheelsets\": {}, \"offsets\": [{}]}}",
+                quote(k.fmu),
+                quote(k.item),
+                value,
+                k.wheelsets,
+                offsets.join(", ")
+            )
+        })
+        .collect();
+    format!(
+        "{{\"fmus\": [{}],\n \"vehicles\": [\n{}\n]}}\n",
+        fmus.join(", "),
+        vehicles.join(",\n")
+    )
 }

@@ -24,6 +24,7 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 use wheelflat::fmu::vars::{Causality, FMUS, FmuTable, VarSpec, VarType, enums};
 use wheelflat::fmu::{Instance, Kind, Logger, Status};
+use wheelflat::vehicle::{VEHICLE_KINDS, kind_of_fmu};
 use zip::write::SimpleFileOptions;
 
 /// `DefaultExperiment stopTime` of every SSP (s).
@@ -284,23 +285,21 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
         value(track, "track.window.ahead", WINDOW),
         value(track, "track.window.behind", WINDOW),
     ];
-    if n > 1 {
-        // A bogie or the wagon: the track carries its wheelsets at their offsets (the
-        // wheelbase, and the wagon's bogie distance), and at the axle boxes the bogies'
-        // pitching side frames.
-        let a = spec(vehicle, "vehicle.wheelbase").start;
-        let (offsets, model) = match n {
-            2 => (vec![a], enums::vehicle_model::HALF_CAR),
-            4 => {
-                let d = spec(vehicle, "vehicle.bogie_distance").start;
-                (vec![a, d, d + a], enums::vehicle_model::WAGON)
-            }
-            _ => panic!("a vehicle on {n} wheelsets"),
-        };
+    // The vehicle's kind in the registry: on several wheelsets, the track carries its
+    // wheelsets at the offsets its own parameters give (the wheelbase, the wagon's
+    // bogie distance) and, at the axle boxes, what its kind has there.
+    let kind = kind_of_fmu(vehicle.model_identifier).expect("a vehicle of the registry");
+    let start = |name: &str| spec(vehicle, name).start;
+    if let Some(c) = kind.own_carrier(&start) {
         track_values.push(value(track, "wheelsets", n as f64));
-        for (x, k) in offsets.into_iter().zip(2..) {
+        for ((x, _), k) in c.model().offsets().into_iter().zip(2..) {
             track_values.push(value(track, &format!("wheelset[{k}].offset"), x));
         }
+        let model = enums::vehicle_model::ITEMS
+            .iter()
+            .find(|(item, _)| *item == kind.item)
+            .expect("each kind is an item of VehicleModel")
+            .1;
         track_values.push(value(track, "vehicle.model", model));
     }
     let vehicle_values = vec![
@@ -328,10 +327,10 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
     }
 }
 
-/// The six shipped systems.
+/// The shipped systems: TrackContact with each kind of vehicle's FMU at each interface.
 pub fn systems() -> Vec<System> {
     let mut all = Vec::new();
-    for vehicle in ["RollPlaneVehicle", "HalfCarBogie", "Wagon"] {
+    for vehicle in VEHICLE_KINDS.iter().map(|k| k.fmu) {
         for interface in [Interface::Contact, Interface::AxleBox] {
             all.push(system(vehicle, interface));
         }

@@ -4,6 +4,7 @@
 use super::Kind;
 use crate::contact::ContactModel;
 use crate::error::Error;
+use crate::fmu::vars;
 use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
 };
@@ -16,7 +17,7 @@ use crate::track::{
     RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
     TrackParams,
 };
-use crate::vehicle::{HalfCarParams, RollPlaneParams, WagonParams};
+use crate::vehicle::{AboveAxleBoxes, RollPlaneParams, VehicleKind, kind_of_item};
 use crate::wheel::{FlatShape, FlatSpec, OutOfRoundness};
 use std::io::Read;
 use std::sync::Arc;
@@ -60,24 +61,29 @@ pub fn track_params(v: &[f64]) -> TrackParams {
     }
 }
 
+/// The variables' values by name, for the vehicle registry
+/// ([`crate::vehicle::VehicleKind::carrier`]).
+fn by_name(v: &[f64]) -> impl Fn(&str) -> f64 + '_ {
+    move |name| {
+        // The registry names variables of the table (its test builds every kind from
+        // its FMU's variables).
+        let r = vars::vr_of(name).unwrap_or_else(|| panic!("{name} is no variable"));
+        v[r as usize]
+    }
+}
+
 /// Roll-plane vehicle parameters (table 4.4 by default).
 pub fn vehicle_params(v: &[f64]) -> RollPlaneParams {
-    let v = |r: u32| v[r as usize];
-    RollPlaneParams {
-        carbody_mass: v(vr::VEHICLE_CARBODY_MASS),
-        bolster_mass: v(vr::VEHICLE_BOLSTER_MASS),
-        bolster_inertia: v(vr::VEHICLE_BOLSTER_INERTIA),
-        sideframe_mass: v(vr::VEHICLE_SIDEFRAME_MASS),
-        wheelset_mass: v(vr::VEHICLE_WHEELSET_MASS),
-        wheelset_inertia: v(vr::VEHICLE_WHEELSET_INERTIA),
-        primary_stiffness: v(vr::VEHICLE_PRIMARY_STIFFNESS),
-        primary_damping: v(vr::VEHICLE_PRIMARY_DAMPING),
-        primary_spacing: v(vr::VEHICLE_PRIMARY_SPACING),
-        secondary_stiffness: v(vr::VEHICLE_SECONDARY_STIFFNESS),
-        secondary_damping: v(vr::VEHICLE_SECONDARY_DAMPING),
-        secondary_spacing: v(vr::VEHICLE_SECONDARY_SPACING),
-        gravity: v(vr::GRAVITY),
-    }
+    crate::vehicle::roll_plane(&by_name(v))
+}
+
+/// The kind of vehicle `vehicle.model` names.
+fn vehicle_model(v: &[f64]) -> &'static VehicleKind {
+    // The table's range holds the enumeration to its items (checked at set), and the
+    // registry's test gives every item a kind.
+    enums::vehicle_model::item(v[vr::VEHICLE_MODEL as usize])
+        .and_then(kind_of_item)
+        .expect("vehicle.model is an item of the registry")
 }
 
 /// Whether the FMU couples at the axle boxes (`interface = axle_box`).
@@ -107,58 +113,14 @@ pub fn wheelset_params(v: &[f64]) -> RollPlaneParams {
     }
 }
 
-/// The half-car bogie of the roll-plane vehicle's parameters (half a bogie) with the
-/// wheelbase `wheelbase` (m) and the side frames' pitch inertia of the variables.
-fn half_car_params(v: &[f64], wheelbase: f64) -> HalfCarParams {
-    HalfCarParams::from_roll_plane(
-        &vehicle_params(v),
-        wheelbase,
-        v[vr::VEHICLE_SIDEFRAME_PITCH_INERTIA as usize],
-    )
-}
-
-/// The wagon of the roll-plane vehicle's parameters (table 4.4: the car body four
-/// times its quarter, each bogie the half-car of [`half_car_params`]) with the
-/// wheelbase `wheelbase` (m), the bogie centre distance `distance` (m) and the car
-/// body's inertias of the variables.
-fn wagon_params(v: &[f64], wheelbase: f64, distance: f64) -> WagonParams {
-    WagonParams {
-        carbody_mass: 4.0 * v[vr::VEHICLE_CARBODY_MASS as usize],
-        carbody_pitch_inertia: v[vr::VEHICLE_CARBODY_PITCH_INERTIA as usize],
-        carbody_roll_inertia: v[vr::VEHICLE_CARBODY_ROLL_INERTIA as usize],
-        bogie_distance: distance,
-        bogie: half_car_params(v, wheelbase),
-    }
-}
-
-/// The vehicle as a co-simulation unit (RollPlaneVehicle, HalfCarBogie, Wagon).
+/// The vehicle as a co-simulation unit (the own FMU of a kind of vehicle).
 pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
     let val = |r: u32| v[r as usize];
-    let model = match kind {
-        Kind::HalfCarBogie => UnitModel::HalfCar(half_car_params(v, val(vr::VEHICLE_WHEELBASE))),
-        Kind::Wagon => UnitModel::Wagon(wagon_params(
-            v,
-            val(vr::VEHICLE_WHEELBASE),
-            val(vr::VEHICLE_BOGIE_DISTANCE),
-        )),
-        _ => UnitModel::RollPlane,
+    let get = by_name(v);
+    let model = match kind.vehicle().and_then(|k| k.own_carrier(&get)) {
+        Some(c) => UnitModel::Carrier(c),
+        None => UnitModel::RollPlane,
     };
-    // Only a vehicle on several wheelsets has the trailing wheelsets' (the others'
-    // values are not theirs).
-    const TRAILING_STATIC: [[u32; 2]; 3] = [
-        [
-            vr::WHEELSET_2_STATIC_WHEEL_Z_LEFT,
-            vr::WHEELSET_2_STATIC_WHEEL_Z_RIGHT,
-        ],
-        [
-            vr::WHEELSET_3_STATIC_WHEEL_Z_LEFT,
-            vr::WHEELSET_3_STATIC_WHEEL_Z_RIGHT,
-        ],
-        [
-            vr::WHEELSET_4_STATIC_WHEEL_Z_LEFT,
-            vr::WHEELSET_4_STATIC_WHEEL_Z_RIGHT,
-        ],
-    ];
     let n = model.wheelsets();
     VehicleUnitParams {
         vehicle: vehicle_params(v),
@@ -168,9 +130,11 @@ pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
         static_wheel_z: [val(vr::STATIC_WHEEL_Z_LEFT), val(vr::STATIC_WHEEL_Z_RIGHT)],
         axle_box: axle_box(v),
         model,
+        // Only a vehicle on several wheelsets has the trailing wheelsets' (the others'
+        // values are not theirs).
         trailing_static_wheel_z: std::array::from_fn(|k| {
             if k + 1 < n {
-                TRAILING_STATIC[k].map(val)
+                ["left", "right"].map(|s| get(&format!("wheelset[{}].static_wheel_z.{s}", k + 2)))
             } else {
                 [0.0; 2]
             }
@@ -217,32 +181,25 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         .map(|&r| val(r))
         .collect();
     let static_load = [val(vr::STATIC_LOAD_LEFT), val(vr::STATIC_LOAD_RIGHT)];
+    let model = vehicle_model(v);
+    let offsets: Vec<f64> = OFFSET_VRS.iter().map(|&r| val(r)).collect();
     let vehicle = match kind {
-        Kind::CoupledSystem if val(vr::VEHICLE_MODEL) == enums::vehicle_model::HALF_CAR => {
-            VehicleSpec::HalfCar(half_car_params(v, val(OFFSET_VRS[0])))
-        }
-        // The wagon's wheelbase and bogie distance are the offsets of wheelsets 2 and 3
-        // (the engine checks the fourth).
-        Kind::CoupledSystem if val(vr::VEHICLE_MODEL) == enums::vehicle_model::WAGON => {
-            VehicleSpec::Wagon(wagon_params(v, val(OFFSET_VRS[0]), val(OFFSET_VRS[1])))
-        }
-        Kind::CoupledSystem => VehicleSpec::RollPlane(vehicle_params(v)),
+        Kind::CoupledSystem => match model.carrier {
+            Some(build) => VehicleSpec::Carrier(build(&by_name(v), &offsets)),
+            None => VehicleSpec::RollPlane(vehicle_params(v)),
+        },
         _ if axle_box(v) => VehicleSpec::AxleBox {
             vehicle: wheelset_params(v),
-            side_frames: if val(vr::VEHICLE_MODEL) != enums::vehicle_model::ROLL_PLANE {
-                SideFrameSpec::HalfCar {
+            side_frames: match model.above_axle_boxes {
+                AboveAxleBoxes::SideFramePerWheelset => SideFrameSpec::PerWheelset {
+                    mass: val(vr::VEHICLE_SIDEFRAME_MASS),
+                },
+                AboveAxleBoxes::BogieSideFrames { bogies } => SideFrameSpec::HalfCar {
                     mass: 2.0 * val(vr::VEHICLE_SIDEFRAME_MASS),
                     pitch_inertia: val(vr::VEHICLE_SIDEFRAME_PITCH_INERTIA),
-                    bogies: if val(vr::VEHICLE_MODEL) == enums::vehicle_model::WAGON {
-                        2
-                    } else {
-                        1
-                    },
-                }
-            } else {
-                SideFrameSpec::PerWheelset {
-                    mass: val(vr::VEHICLE_SIDEFRAME_MASS),
-                }
+                    bogies,
+                },
+                AboveAxleBoxes::Nothing => SideFrameSpec::Nothing,
             },
             static_load,
         },

@@ -155,7 +155,7 @@ impl Model for FmuModel {
             Error::Unsupported(format!("no model for the FMU {}", table.model_identifier))
         })?;
         let (engine, published) = match kind {
-            Kind::RollPlaneVehicle | Kind::HalfCarBogie | Kind::Wagon => {
+            Kind::Vehicle(_) => {
                 let p = vehicle_unit_params(kind, values);
                 let u = VehicleUnit::new(&p)?;
                 let published = Published {

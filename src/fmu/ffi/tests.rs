@@ -10,7 +10,7 @@ fn the_file_stem_of_the_binary_is_the_model_identifier() {
             "/tmp/x/binaries/linux64/TrackContact.so",
             Some(Kind::TrackContact),
         ),
-        ("RollPlaneVehicle.so", Some(Kind::RollPlaneVehicle)),
+        ("RollPlaneVehicle.so", Some(Kind::ROLL_PLANE_VEHICLE)),
         (
             "C:/fmu/binaries/win64/CoupledSystem.dll",
             Some(Kind::CoupledSystem),

@@ -25,7 +25,7 @@ fn parameter_ranges_follow_from_physics_and_match_the_engine() {
     }
     let cases: [(Kind, u32, f64, &str); 8] = [
         (
-            Kind::RollPlaneVehicle,
+            Kind::ROLL_PLANE_VEHICLE,
             vr::VEHICLE_PRIMARY_STIFFNESS,
             1e308,
             "vehicle.primary.stiffness",
@@ -49,7 +49,7 @@ fn parameter_ranges_follow_from_physics_and_match_the_engine() {
             "track.rail.mass",
         ),
         (
-            Kind::RollPlaneVehicle,
+            Kind::ROLL_PLANE_VEHICLE,
             vr::VEHICLE_SECONDARY_SPACING,
             5e-324,
             "vehicle.secondary.spacing",
@@ -159,7 +159,7 @@ fn contacts_and_suspensions_too_soft_to_carry_the_load_are_refused_at_initialisa
             "`vehicle.primary.stiffness`",
         ),
         (
-            Kind::RollPlaneVehicle,
+            Kind::ROLL_PLANE_VEHICLE,
             vr::VEHICLE_SECONDARY_STIFFNESS,
             1e4,
             "`vehicle.secondary.stiffness`",
@@ -368,7 +368,7 @@ fn vehicle_forces_no_physical_run_reaches_are_refused_by_the_step_that_would_use
     // Issue 25: the set takes what the model description declares (|F| <= 1e7 N); the
     // physical bound depends on the parameters (20 times the static wheel load, at least
     // 2 MN), so the step refuses it, naming the force, and nothing moves.
-    let (mut v, _) = instance(Kind::RollPlaneVehicle);
+    let (mut v, _) = instance(Kind::ROLL_PLANE_VEHICLE);
     v.enter_initialization().unwrap();
     v.exit_initialization().unwrap();
     let w = v.value(vr::CONTACT_LEFT_FORCE);

@@ -215,7 +215,7 @@ fn steps_too_small_or_too_large_are_refused_or_harmless_and_never_hang() {
         "{}",
         e.message
     );
-    let (mut v, _) = instance(Kind::RollPlaneVehicle);
+    let (mut v, _) = instance(Kind::ROLL_PLANE_VEHICLE);
     v.enter_initialization().unwrap();
     v.exit_initialization().unwrap();
     let e = v.do_step(0.0, 1e9).unwrap_err();
@@ -252,7 +252,7 @@ fn steps_too_small_or_too_large_are_refused_or_harmless_and_never_hang() {
     // solver.dt far below the critical step is refused at initialisation.
     for kind in [
         Kind::TrackContact,
-        Kind::RollPlaneVehicle,
+        Kind::ROLL_PLANE_VEHICLE,
         Kind::CoupledSystem,
     ] {
         let (mut i, log) = instance(kind);

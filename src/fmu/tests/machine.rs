@@ -22,7 +22,7 @@ fn default_start_values_are_the_reference_scenario() {
     assert_eq!(t.value(vr::STATIC_LOAD_LEFT), w);
     let sim = Simulation::new(&t.scenario()).unwrap();
     assert_eq!(t.value(vr::WHEEL_LEFT_Z), sim.wheel_z()[0]);
-    let (v, _) = instance(Kind::RollPlaneVehicle);
+    let (v, _) = instance(Kind::ROLL_PLANE_VEHICLE);
     assert_eq!(v.value(vr::STATIC_WHEEL_Z_LEFT), sim.wheel_z()[0]);
     assert_eq!(v.value(vr::CONTACT_LEFT_FORCE), w);
 }
@@ -185,7 +185,7 @@ fn after_the_model_ended_the_run_steps_are_refused_and_outputs_readable() {
 
 #[test]
 fn a_serialized_state_with_numbers_an_instance_cannot_hold_is_refused() {
-    let (mut i, _) = instance(Kind::RollPlaneVehicle);
+    let (mut i, _) = instance(Kind::ROLL_PLANE_VEHICLE);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     i.do_step(0.0, 1e-3).unwrap();

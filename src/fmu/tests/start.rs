@@ -114,7 +114,7 @@ fn the_communication_point_must_be_the_fmu_time_to_the_clock_rounding() {
 fn the_vehicle_follows_the_masters_clock_far_from_zero() {
     // At t = 1e9 s each t + 1e-3 rounds by up to 6e-8 s; summing the h given drifted
     // 1e-3 s from the clock over 2e4 calls.
-    let (mut v, _) = instance(Kind::RollPlaneVehicle);
+    let (mut v, _) = instance(Kind::ROLL_PLANE_VEHICLE);
     v.setup_experiment(1e9, None).unwrap();
     v.enter_initialization().unwrap();
     v.exit_initialization().unwrap();
@@ -139,7 +139,7 @@ fn the_vehicle_follows_the_masters_clock_far_from_zero() {
 fn a_vehicle_whose_first_forces_are_all_zero_is_told_of_connectors_that_start_at_zero() {
     // Issue 38: fmpy's simulate_ssp starts every connector at 0; the vehicle's warning
     // told the user to set TrackContact's static_load.*, which already matched.
-    let (mut i, log) = instance(Kind::RollPlaneVehicle);
+    let (mut i, log) = instance(Kind::ROLL_PLANE_VEHICLE);
     i.enter_initialization().unwrap();
     i.exit_initialization().unwrap();
     i.set_real(

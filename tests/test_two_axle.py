@@ -1,0 +1,124 @@
+"""The TwoAxleWagon FMU and CoupledSystem with vehicle.model = two_axle (issue 39): the
+static loads, a standstill, the pair at the track's step against CoupledSystem (the same
+arithmetic), at the axle boxes at 1 ms against CoupledSystem, and the reference flat on
+its leading wheel at 70 km/h on the endless track. The shipped system files in OSP
+libcosim and ecos are in tests/test_masters.py (every kind of the registry).
+
+Run by the README's test command (after the FMUs are built)."""
+
+import os
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import wheelflat_fmus as wf  # noqa: E402
+
+ENDLESS = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
+FORCES = wf.every_wheelset(2, ("contact.left.force", "contact.right.force"))
+# Table 4.4: the car body twice the car-body share per wheelset (2 x 20,150 kg) and two
+# wheelsets of 1,120 kg, a quarter of the weight on each wheel (g = 9.81).
+STATIC_LOAD = 0.25 * 9.81 * (2 * 20150.0 + 2 * 1120.0)
+
+
+@pytest.fixture(scope="module")
+def paths():
+    p = {n: os.path.join(wf.FMU_DIR, n + ".fmu") for n in wf.registry()["fmus"]}
+    if not all(os.path.exists(x) for x in p.values()):
+        p = wf.build_fmus()
+    return p
+
+
+@pytest.fixture(scope="module")
+def two_axle(paths):
+    """CoupledSystem's parameters for the TwoAxleWagon's defaults: vehicle.model and the
+    wheelbase from the registry and the FMU."""
+    kind = wf.vehicle_kind("TwoAxleWagon")
+    from fmpy import read_model_description
+    md = read_model_description(paths["TwoAxleWagon"])
+    a = float(next(v.start for v in md.modelVariables if v.name == "wheelset[2].offset"))
+    assert a == 9.0
+    return dict(ENDLESS, **{"vehicle.model": kind["value"], "wheelsets": 2, "wheelset[2].offset": a})
+
+
+def test_the_two_axle_wagon_publishes_a_quarter_of_its_weight_on_every_wheel(paths):
+    u = wf.Unit(paths["TwoAxleWagon"], "w")
+    u.fmu.setupExperiment(startTime=0.0)
+    u.fmu.enterInitializationMode()
+    loads = u.get("static_load.left", "static_load.right")
+    u.fmu.exitInitializationMode()
+    held = u.get(*FORCES)
+    u.close()
+    assert loads == pytest.approx([STATIC_LOAD] * 2, rel=1e-12)
+    assert STATIC_LOAD == pytest.approx(104329.35, abs=0.01)
+    assert held == pytest.approx([STATIC_LOAD] * 4, rel=1e-9)
+
+
+def test_the_two_axle_wagon_alone_at_rest_stays_at_rest(paths):
+    names = ["carbody.z", "carbody.pitch", "carbody.roll", "wheelset[2].z", "sideframe.left.z"]
+    for interface in (1, 2):
+        u = wf.Unit(paths["TwoAxleWagon"], "w")
+        u.fmu.setupExperiment(startTime=0.0)
+        u.set_parameters({"interface": interface})
+        u.fmu.enterInitializationMode()
+        u.fmu.exitInitializationMode()
+        before = np.array(u.get(*names))
+        for k in range(2000):
+            u.fmu.doStep(k * 1e-3, 1e-3)
+        after = np.array(u.get(*names))
+        u.close()
+        assert np.max(np.abs(after - before)) < 1e-8, (interface, before, after)
+
+
+def test_coupled_system_with_the_two_axle_wagon_on_a_level_track_stands_still(paths, two_axle):
+    from fmpy import simulate_fmu
+    start = dict(two_axle, **{"speed": 0.0, "flat.left[1].length": 0.0, "flat.left[1].depth": 0.0})
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.2, start_values=start, output=FORCES,
+                     output_interval=0.01)
+    for name in FORCES:
+        assert np.max(np.abs(r[name] / STATIC_LOAD - 1)) < 1e-8, name
+
+
+def test_the_reference_flat_on_the_leading_wheel_at_70_km_h(paths, two_axle):
+    # CoupledSystem's defaults: the 100 x 1.5 mm haversine flat on the leading left
+    # wheel, 70 km/h, the converged endless track. The impact is the flat's: more than
+    # 2.5 times the static load on the flat wheel, the other wheels far below.
+    from fmpy import simulate_fmu
+    maxima = wf.every_wheelset(2, ("contact.left.max_force", "contact.right.max_force"))
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.3, start_values=two_axle, output=maxima + ["speed"])
+    assert r["speed"][-1] == pytest.approx(70 / 3.6, rel=1e-9)
+    peaks = [r[n][-1] for n in maxima]
+    print("two-axle wagon, reference flat at 70 km/h: peaks (kN)", [round(p / 1e3, 1) for p in peaks])
+    assert peaks[0] > 2.5 * STATIC_LOAD
+    assert max(peaks[1:]) < 1.5 * STATIC_LOAD
+
+
+def test_the_pair_at_the_tracks_step_is_coupled_system(paths, two_axle):
+    from fmpy import simulate_fmu
+    rec = []
+    peak = wf.run_two_axle(paths, 0.06, track_params=ENDLESS, record=rec)
+    got = np.array([x[1:] for x in rec])
+    h = rec[1][0] - rec[0][0]
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.06, start_values=two_axle, output=FORCES,
+                     output_interval=h)
+    ref = np.column_stack([r[n] for n in FORCES])[:len(got)]
+    assert got.shape == ref.shape
+    assert np.max(np.abs(got - ref)) <= 1e-9 * STATIC_LOAD
+    assert peak[0][0] > 2.5 * STATIC_LOAD
+
+
+def test_the_two_axle_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent(paths, two_axle):
+    # fmpy's sequential loop every 1 ms, TrackContact carrying nothing above the axle
+    # boxes (vehicle.model = two_axle): every wheel's largest force over 0.3 s within
+    # 1 % of CoupledSystem's.
+    from fmpy import simulate_fmu
+    peak = wf.run_two_axle_axle_box(paths, 0.3, 1e-3, track_params=ENDLESS)
+    maxima = wf.every_wheelset(2, ("contact.left.max_force", "contact.right.max_force"))
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.3, start_values=two_axle, output=maxima)
+    ref = [r[n][-1] for n in maxima]
+    got = [x for w in peak for x in w]
+    errors = [g / m - 1 for g, m in zip(got, ref)]
+    print("two-axle wagon at the axle boxes, 1 ms, fmpy:", [f"{100 * e:+.3f} %" for e in errors])
+    assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
