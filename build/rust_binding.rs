@@ -14,6 +14,18 @@ fn const_name(name: &str) -> String {
         .to_uppercase()
 }
 
+/// `roll_plane` -> `RollPlane`: an item's name as a Rust variant.
+fn camel(name: &str) -> String {
+    name.split('_')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
 /// `ContactModel` -> `contact_model` (`upper`: `CONTACT_MODEL`).
 fn split_camel(name: &str, upper: bool) -> String {
     let mut s = String::new();
@@ -155,6 +167,34 @@ fn enumerations(rust: &mut String, table: &Table) {
                 .join(", ")
         )
         .unwrap();
+        // The items as a Rust enumeration, decoded from a value in one place: a match
+        // over it is exhaustive, so an item added to the table does not compile until
+        // the engine maps it.
+        let variants: Vec<String> = items.iter().map(|x| camel(&x.name)).collect();
+        writeln!(
+            rust,
+            "        /// The items of `{ty}`.\n        \
+             #[derive(Debug, Clone, Copy, PartialEq, Eq)]\n        \
+             pub enum Item {{\n{}        }}\n        \
+             impl Item {{\n            \
+             /// The item of the value `value` (the variable's value); `None` for a value\n            \
+             /// no item has (the FMI layer refuses those at set).\n            \
+             pub fn of(value: f64) -> Option<Item> {{\n{}                None\n            }}\n        }}",
+            items
+                .iter()
+                .zip(&variants)
+                .map(|(x, v)| format!("            /// {}\n            {v},\n", x.description))
+                .collect::<String>(),
+            items
+                .iter()
+                .zip(&variants)
+                .map(|(x, v)| format!(
+                    "                if value == {}.0 {{\n                    return Some(Item::{v});\n                }}\n",
+                    x.value
+                ))
+                .collect::<String>(),
+        )
+        .unwrap();
         writeln!(rust, "    }}").unwrap();
     }
     writeln!(rust, "}}\n").unwrap();
@@ -271,6 +311,36 @@ fn wheelset_vrs(rust: &mut String, table: &Table) {
                 .map(|q| vr_of(table, &format!("wheelset[{k}].sideframe.{q}")).to_string())
                 .join(", ")
         )),
+    )
+    .unwrap();
+    // `[left, right]` pairs of every wheelset, the leading one first (its names without
+    // the `wheelset[k].` prefix).
+    let pairs = |what: &str| -> String {
+        let names = std::iter::once(String::new())
+            .chain(trailing.iter().map(|k| format!("wheelset[{k}].")));
+        names
+            .map(|p| {
+                format!(
+                    "[{}, {}]",
+                    vr_of(table, &format!("{p}{}", what.replace("{s}", "left"))),
+                    vr_of(table, &format!("{p}{}", what.replace("{s}", "right")))
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    writeln!(
+        rust,
+        "/// `contact.left.force`, `.right.force` of every wheelset, the leading one first.\n\
+         pub const CONTACT_FORCE_VRS: [[u32; 2]; {m}] = [{}];\n\
+         /// `axle_box.left.force`, `.right.force` of every wheelset, the leading one first.\n\
+         pub const AXLE_BOX_FORCE_VRS: [[u32; 2]; {m}] = [{}];\n\
+         /// `static_wheel_z.left`, `.right` of every wheelset, the leading one first.\n\
+         pub const STATIC_WHEEL_Z_VRS: [[u32; 2]; {m}] = [{}];",
+        pairs("contact.{s}.force"),
+        pairs("axle_box.{s}.force"),
+        pairs("static_wheel_z.{s}"),
+        m = n + 1,
     )
     .unwrap();
     let sites: Vec<String> = (1..)

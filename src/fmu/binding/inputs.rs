@@ -5,7 +5,9 @@
 use super::Kind;
 use super::unit::{Engine, FmuModel};
 use crate::error::Error;
-use crate::fmu::vars::{TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, vr};
+use crate::fmu::vars::{
+    AXLE_BOX_FORCE_VRS, CONTACT_FORCE_VRS, TRAILING_FRAME_VRS, TRAILING_INPUT_VRS, vr,
+};
 use crate::sim::{Sample, Simulation, VehicleState};
 
 /// TrackContact's side-frame inputs of the leading wheelset (`interface = axle_box`):
@@ -15,40 +17,6 @@ pub(super) const FRAME_VRS: [u32; 4] = [
     vr::SIDEFRAME_RIGHT_Z,
     vr::SIDEFRAME_LEFT_V,
     vr::SIDEFRAME_RIGHT_V,
-];
-
-/// The vehicle units' contact-force inputs of each wheelset: left, right.
-const VEHICLE_CONTACT_VRS: [[u32; 2]; 4] = [
-    [vr::CONTACT_LEFT_FORCE, vr::CONTACT_RIGHT_FORCE],
-    [
-        vr::WHEELSET_2_CONTACT_LEFT_FORCE,
-        vr::WHEELSET_2_CONTACT_RIGHT_FORCE,
-    ],
-    [
-        vr::WHEELSET_3_CONTACT_LEFT_FORCE,
-        vr::WHEELSET_3_CONTACT_RIGHT_FORCE,
-    ],
-    [
-        vr::WHEELSET_4_CONTACT_LEFT_FORCE,
-        vr::WHEELSET_4_CONTACT_RIGHT_FORCE,
-    ],
-];
-
-/// The vehicle units' primary-force inputs of each wheelset (`interface = axle_box`).
-const VEHICLE_AXLE_BOX_VRS: [[u32; 2]; 4] = [
-    [vr::AXLE_BOX_LEFT_FORCE, vr::AXLE_BOX_RIGHT_FORCE],
-    [
-        vr::WHEELSET_2_AXLE_BOX_LEFT_FORCE,
-        vr::WHEELSET_2_AXLE_BOX_RIGHT_FORCE,
-    ],
-    [
-        vr::WHEELSET_3_AXLE_BOX_LEFT_FORCE,
-        vr::WHEELSET_3_AXLE_BOX_RIGHT_FORCE,
-    ],
-    [
-        vr::WHEELSET_4_AXLE_BOX_LEFT_FORCE,
-        vr::WHEELSET_4_AXLE_BOX_RIGHT_FORCE,
-    ],
 ];
 
 /// Hands wheelset `k` of `sim` its wheel inputs `[left z, right z, rotation]` (value
@@ -142,9 +110,9 @@ impl FmuModel {
                     u.set_speed(v(vr::SPEED))?;
                 }
                 let refs = if u.is_axle_box() {
-                    VEHICLE_AXLE_BOX_VRS
+                    AXLE_BOX_FORCE_VRS
                 } else {
-                    VEHICLE_CONTACT_VRS
+                    CONTACT_FORCE_VRS
                 };
                 for (k, [l, r]) in refs.into_iter().take(u.wheelsets()).enumerate() {
                     u.set_forces_of(k, [v(l), v(r)])?;
@@ -162,9 +130,9 @@ impl FmuModel {
             // contact forces of a vehicle on several wheelsets (which share its weight by
             // its static state).
             let refs = match (u.is_axle_box(), u.wheelsets()) {
-                (true, _) => VEHICLE_AXLE_BOX_VRS,
+                (true, _) => AXLE_BOX_FORCE_VRS,
                 (false, 1) => return None,
-                (false, _) => VEHICLE_CONTACT_VRS,
+                (false, _) => CONTACT_FORCE_VRS,
             };
             for (k, [l, rr]) in refs.into_iter().take(u.wheelsets()).enumerate() {
                 let f = u.held_forces_of(k)?;

@@ -5,8 +5,12 @@ use super::Kind;
 use crate::contact::ContactModel;
 use crate::error::Error;
 use crate::fmu::vars;
+use crate::fmu::vars::enums::{
+    contact_model, flat_shape, interface, rail_between_nodes, support_law,
+};
 use crate::fmu::vars::{
-    FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, TRAILING, TRAILING_FLAT_VRS, enums, vr,
+    FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, STATIC_WHEEL_Z_VRS, TRAILING, TRAILING_FLAT_VRS,
+    enums, vr,
 };
 use crate::numerics::Table;
 use crate::sim::{
@@ -44,21 +48,29 @@ pub fn track_params(v: &[f64]) -> TrackParams {
         sleeper_inertia: v(vr::TRACK_SLEEPER_INERTIA),
         ends: RailEnds::Fixed,
         // The table's range holds the enumeration to its items (checked at set).
-        between_nodes: if v(vr::TRACK_RAIL_BETWEEN_NODES) == enums::rail_between_nodes::LINEAR {
-            RailBetweenNodes::Linear
-        } else {
-            RailBetweenNodes::Beam
+        between_nodes: match item(
+            rail_between_nodes::Item::of,
+            v(vr::TRACK_RAIL_BETWEEN_NODES),
+        ) {
+            rail_between_nodes::Item::Linear => RailBetweenNodes::Linear,
+            rail_between_nodes::Item::Beam => RailBetweenNodes::Beam,
         },
         supports: Supports {
-            law: if v(vr::TRACK_SUPPORTS) == enums::support_law::TENSIONLESS {
-                SupportLaw::Tensionless
-            } else {
-                SupportLaw::Linear
+            law: match item(support_law::Item::of, v(vr::TRACK_SUPPORTS)) {
+                support_law::Item::Tensionless => SupportLaw::Tensionless,
+                support_law::Item::Linear => SupportLaw::Linear,
             },
             pad_preload: v(vr::TRACK_PAD_PRELOAD),
             ballast_preload: v(vr::TRACK_BALLAST_PRELOAD),
         },
     }
+}
+
+/// The item of an enumeration variable's value `value`, decoded by the table's
+/// generated `of`: the FMI layer accepts only the items' values (its range, checked at
+/// set), so a value without an item is a defect of the layer.
+fn item<T>(of: fn(f64) -> Option<T>, value: f64) -> T {
+    of(value).expect("the FMI layer holds an enumeration to its items")
 }
 
 /// The variables' values by name, for the vehicle registry
@@ -88,7 +100,10 @@ fn vehicle_model(v: &[f64]) -> &'static VehicleKind {
 
 /// Whether the FMU couples at the axle boxes (`interface = axle_box`).
 pub fn axle_box(v: &[f64]) -> bool {
-    v[vr::INTERFACE as usize] == enums::interface::AXLE_BOX
+    match item(interface::Item::of, v[vr::INTERFACE as usize]) {
+        interface::Item::AxleBox => true,
+        interface::Item::Contact => false,
+    }
 }
 
 /// TrackContact's wheelset and primary suspension (`interface = axle_box`), in the
@@ -134,7 +149,7 @@ pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
         // values are not theirs).
         trailing_static_wheel_z: std::array::from_fn(|k| {
             if k + 1 < n {
-                ["left", "right"].map(|s| get(&format!("wheelset[{}].static_wheel_z.{s}", k + 2)))
+                STATIC_WHEEL_Z_VRS[k + 1].map(val)
             } else {
                 [0.0; 2]
             }
@@ -151,10 +166,9 @@ fn flat(v: &[f64], f: &[u32; 4]) -> FlatSpec {
         length: val(f[0]),
         depth: if depth == 0.0 { None } else { Some(depth) },
         angle: val(f[2]),
-        shape: if val(f[3]) == enums::flat_shape::CHORD {
-            FlatShape::Chord
-        } else {
-            FlatShape::Haversine
+        shape: match item(flat_shape::Item::of, val(f[3])) {
+            flat_shape::Item::Chord => FlatShape::Chord,
+            flat_shape::Item::Haversine => FlatShape::Haversine,
         },
     }
 }
@@ -212,10 +226,9 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
         wheel_radius: val(vr::WHEEL_RADIUS),
         flats,
         // The table's range holds the enumeration to its items (checked at set).
-        contact_model: if val(vr::CONTACT_MODEL) == enums::contact_model::HERTZ {
-            ContactModel::Hertz
-        } else {
-            ContactModel::Adaptive
+        contact_model: match item(contact_model::Item::of, val(vr::CONTACT_MODEL)) {
+            contact_model::Item::Hertz => ContactModel::Hertz,
+            contact_model::Item::Adaptive => ContactModel::Adaptive,
         },
         kw: val(vr::CONTACT_KW),
         hertz_coefficient: val(vr::CONTACT_CH),

@@ -196,7 +196,13 @@ impl Model for FmuModel {
                         None => sim.sample_of(k).map_or([0.0; 2], |s| s.wheel_z),
                     })
                     .collect();
-                let relative = values[vr::INPUTS_DATUM as usize] == enums::input_datum::FIRST_STEP;
+                // The FMI layer holds the enumeration to its items (its range, at set).
+                let relative = match enums::input_datum::Item::of(values[vr::INPUTS_DATUM as usize])
+                    .expect("inputs.datum is one of its items")
+                {
+                    enums::input_datum::Item::FirstStep => true,
+                    enums::input_datum::Item::Absolute => false,
+                };
                 InputDatum::new(relative, statics)
             }
             _ => InputDatum::new(false, Vec::new()),
