@@ -271,7 +271,7 @@ impl Simulation {
             VehicleSpec::AxleBox { side_frames, .. } => side_frames.inertia(s)?,
             _ => (crate::vehicle::SideFrameInertia::single(1.0), false),
         };
-        let vehicle = || -> Result<VehicleState> {
+        let vehicle = |axle: usize| -> Result<VehicleState> {
             Ok(match &s.vehicle {
                 VehicleSpec::RollPlane(p) => {
                     VehicleState::RollPlane(RollPlaneVehicle::new(*p, dt)?)
@@ -290,10 +290,10 @@ impl Simulation {
                     rates: InputRates::default(),
                 },
                 // A vehicle on several wheelsets ([`VehicleSpec::carrier`]) moves them.
-                VehicleSpec::Carrier(_) => VehicleState::OnBogie { wheel_z: [0.0; 2] },
+                VehicleSpec::Carrier(_) => VehicleState::OnBogie { axle },
             })
         };
-        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle()?, "")?
+        let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle(0)?, "")?
             .with_roundness(s.roundness.clone());
         let trailing = s
             .trailing
@@ -302,7 +302,7 @@ impl Simulation {
             .map(|(w, k)| {
                 let name = format!("wheelset[{k}].");
                 Ok(
-                    Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle()?, &name)?
+                    Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle(k - 1)?, &name)?
                         .with_roundness(w.roundness.clone()),
                 )
             })

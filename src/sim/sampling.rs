@@ -27,6 +27,9 @@ impl Simulation {
         {
             return rates.wheel_z_at(*wheel_z, self.time());
         }
+        if let (VehicleState::OnBogie { axle }, Some(b)) = (&w.vehicle, &self.carrier) {
+            return b.wheel_z()[*axle];
+        }
         match w.vehicle.wheel_z() {
             Some(z) => z,
             None => self.rail_z_under(w.position(self.position()) - self.origin),

@@ -501,7 +501,7 @@ impl Simulation {
     }
 
     /// Advances the vehicle on several wheelsets one step under the contact forces of
-    /// its wheelsets' samples at `t_j`, then moves their wheels.
+    /// its wheelsets' samples at `t_j` (which moves their wheels: they are its).
     #[inline(never)]
     fn step_carrier(&mut self) {
         if let Some(b) = &mut self.carrier {
@@ -510,20 +510,6 @@ impl Simulation {
                 *pk = w.forces();
             }
             b.step(&p);
-        }
-        self.sync_carrier_wheels();
-    }
-
-    /// The carrying vehicle's wheel displacements into its wheelsets.
-    pub(super) fn sync_carrier_wheels(&mut self) {
-        let Some(b) = &self.carrier else { return };
-        let z = b.wheel_z();
-        for (k, zk) in z.into_iter().enumerate().take(b.wheelsets()) {
-            if let Some(VehicleState::OnBogie { wheel_z }) =
-                self.wheelsets.get_mut(k).map(|w| &mut w.vehicle)
-            {
-                *wheel_z = zk;
-            }
         }
     }
 

@@ -182,7 +182,6 @@ impl Simulation {
         if let Some(b) = &mut self.carrier {
             b.set_state_vector(&v[total - nb..])?;
         }
-        self.sync_carrier_wheels();
         self.motion = Motion::from_slice(tail);
         if let Some(w) = &mut self.window {
             w.origin_span = origin_span as i64;

@@ -105,18 +105,13 @@ impl Simulation {
         let n = self.wheelsets.len();
         let mut loads = vec![self.static_load; n];
         for _ in 0..STATIC_ITERATIONS {
-            self.rest_on(&loads)?;
+            let heights = self.rest_on(&loads)?;
             let Some(b) = &mut self.carrier else {
                 return Ok(());
             };
-            let z: crate::vehicle::Axles = std::array::from_fn(|k| {
-                self.wheelsets
-                    .get(k)
-                    .and_then(|w| w.vehicle.wheel_z())
-                    .unwrap_or([0.0; 2])
-            });
+            let z: crate::vehicle::Axles =
+                std::array::from_fn(|k| heights.get(k).copied().unwrap_or([0.0; 2]));
             let held = b.set_static(&z)?;
-            self.sync_carrier_wheels();
             let scale = self.static_load[0].max(self.static_load[1]).max(1.0);
             let change = (0..n)
                 .flat_map(|k| (0..2).map(move |i| (k, i)))
@@ -137,8 +132,10 @@ impl Simulation {
     }
 
     /// The track under the wheel loads `loads[k]` `[left, right]` (N) of every wheelset
-    /// at rest, and each wheelset's wheels (its vehicle) at rest on it.
-    fn rest_on(&mut self, loads: &[[f64; 2]]) -> Result<()> {
+    /// at rest, and each wheelset's wheels (its vehicle) at rest on it; returns every
+    /// wheelset's wheel heights there (m), for the vehicle on several wheelsets.
+    fn rest_on(&mut self, loads: &[[f64; 2]]) -> Result<Vec<[f64; 2]>> {
+        let mut heights = Vec::with_capacity(loads.len());
         self.clear_cache();
         let x = self.position() - self.origin;
         let p = self.static_load;
@@ -179,13 +176,13 @@ impl Simulation {
                 VehicleState::RollPlane(v) => v.set_static(zw)?,
                 VehicleState::AxleBox(link) => link.set_static(zw, p),
                 VehicleState::LumpedWheels(v) => v.set_static(zw),
-                VehicleState::ConstantLoad(_) => {}
-                VehicleState::External { wheel_z, .. } | VehicleState::OnBogie { wheel_z } => {
-                    *wheel_z = zw
-                }
+                // The vehicle on several wheelsets rests on `heights` after this.
+                VehicleState::ConstantLoad(_) | VehicleState::OnBogie { .. } => {}
+                VehicleState::External { wheel_z, .. } => *wheel_z = zw,
             }
+            heights.push(zw);
         }
-        Ok(())
+        Ok(heights)
     }
 
     /// Refuses a discrete track that sinks more than [`MAX_STATIC_RAIL_DEFLECTION`]

@@ -20,12 +20,12 @@ pub enum VehicleState {
     /// above it outside ([`crate::vehicle::PrimaryLink`]): the side frames' motion is
     /// the input, the primary forces the output.
     AxleBox(crate::vehicle::PrimaryLink),
-    /// A wheelset of a vehicle on several wheelsets, the half-car bogie or the wagon
+    /// Wheelset `axle` (0 the leading one) of the vehicle on several wheelsets
     /// ([`super::Simulation::carrier`]), which moves its wheels: their displacements
-    /// `[left, right]` (m) after the vehicle's last step.
+    /// are the vehicle's, read from it (no copy).
     OnBogie {
-        /// Wheel-centre displacements `[left, right]` (m).
-        wheel_z: [f64; 2],
+        /// The wheelset's index among the vehicle's.
+        axle: usize,
     },
     /// Wheels moved from outside.
     External {
@@ -43,17 +43,17 @@ pub enum VehicleState {
 }
 
 impl VehicleState {
-    /// Wheel-centre displacements `[left, right]` (m); `None` for constant loads (the
-    /// wheels then ride on the rail).
+    /// Wheel-centre displacements `[left, right]` (m) of the wheelset's own vehicle;
+    /// `None` for constant loads (the wheels then ride on the rail) and for a wheelset
+    /// of a vehicle on several wheelsets, whose wheels that vehicle gives
+    /// ([`super::Simulation`]'s `wheel_z_of`).
     #[inline(always)]
     pub(super) fn wheel_z(&self) -> Option<[f64; 2]> {
         match self {
             VehicleState::RollPlane(v) => Some(v.wheel_z()),
             VehicleState::LumpedWheels(v) => Some(v.wheel_z()),
-            VehicleState::ConstantLoad(_) => None,
-            VehicleState::External { wheel_z, .. } | VehicleState::OnBogie { wheel_z } => {
-                Some(*wheel_z)
-            }
+            VehicleState::ConstantLoad(_) | VehicleState::OnBogie { .. } => None,
+            VehicleState::External { wheel_z, .. } => Some(*wheel_z),
             VehicleState::AxleBox(link) => Some(link.body().wheel_z()),
         }
     }
