@@ -9,7 +9,9 @@ the reason it is not run here. There is no third way: a new command is run (and 
 be quick, under ``QUICK_S``) until it is mapped. Commands written inline in the prose
 (``cargo run --release --example NAME`` and the like) must name a program that exists.
 Every relative link of README.md and docs/**/*.md must point to a file that exists, and
-an anchor into a Markdown file to one of its headings.
+an anchor into a Markdown file to one of its headings. The FMUs docs/ARCHITECTURE.md
+and README.md name are the registry's (fmu/fmus.json), and every ``src/`` path
+docs/ARCHITECTURE.md names exists.
 
 Run by the README's test command, after the FMUs, fmu/systems and .venv are built. The
 scripts the guide shows pack fmu/ again (``wheelflat_fmus.build_fmus``, the same build);
@@ -324,6 +326,48 @@ def test_every_relative_link_points_to_what_exists(page):
         elif anchor and full.endswith(".md") and anchor not in anchors(full):
             broken.append(f"{target}: no heading with that anchor")
     assert not broken, broken
+
+
+# The pages that name the FMUs, and the most lines docs/ARCHITECTURE.md may have.
+FMU_PAGES = ["docs/ARCHITECTURE.md", "README.md"]
+ARCHITECTURE_LINES = 150
+# The shape of an FMU's model identifier where no list knows it: a CamelCase word in the
+# prose (outside code) ending as the FMUs' names end.
+FMU_SHAPE = re.compile(r"(?<![\w.`])[A-Z][a-z]+(?:[A-Z][a-z]+)*(?:Contact|System|Vehicle|Bogie|Wagon)(?![\w`])")
+
+
+def registry_fmus():
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import wheelflat_fmus as wf
+    return set(wf.registry()["fmus"])
+
+
+def fmu_names_in(text, known):
+    """The FMU model identifiers a page names: each name of ``known`` (the registry's,
+    the table's <Fmu> elements, the FMUs' pages) found as a whole word, and any word of
+    an FMU's shape in its prose."""
+    named = {n for n in known if re.search(r"(?<![\w.])" + re.escape(n) + r"(?!\w)", text)}
+    prose = re.sub(r"`[^`\n]*`", "", without_code(text))
+    return named | set(FMU_SHAPE.findall(prose))
+
+
+@pytest.mark.parametrize("page", FMU_PAGES)
+def test_the_fmus_a_page_names_are_the_registrys(page):
+    fmus = registry_fmus()
+    table = open(os.path.join(ROOT, "modelDescription", "variables.xml")).read()
+    known = (fmus | set(re.findall(r'<Fmu\s+modelIdentifier="(\w+)"', table))
+             | {os.path.basename(p)[:-5] for p in glob.glob(os.path.join(ROOT, "build", "pages", "[A-Z]*.html"))})
+    named = fmu_names_in(open(os.path.join(ROOT, page)).read(), known)
+    assert named == fmus, (f"{page} names FMUs the registry lacks: {sorted(named - fmus)}; "
+                           f"leaves out: {sorted(fmus - named)}")
+
+
+def test_the_architecture_page_is_short_and_its_source_paths_exist():
+    text = open(os.path.join(ROOT, "docs", "ARCHITECTURE.md")).read()
+    assert text.count("\n") < ARCHITECTURE_LINES
+    paths = {p.rstrip(".") for p in re.findall(r"(?<![\w/])src/[\w/.-]*", text)}
+    assert paths
+    assert not [p for p in sorted(paths) if not os.path.exists(os.path.join(ROOT, p))]
 
 
 if __name__ == "__main__":
