@@ -18,7 +18,7 @@ use wheelflat::sim::{
     Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
 use wheelflat::track::{RailDefect, SupportLaw, Supports};
-use wheelflat::vehicle::HalfCarParams;
+use wheelflat::vehicle::{CarrierSpec, HalfCarParams};
 use wheelflat::wheel::OutOfRoundness;
 
 fn main() {
@@ -76,7 +76,7 @@ fn main() {
             let VehicleSpec::RollPlane(p) = s.vehicle else {
                 unreachable!()
             };
-            s.vehicle = VehicleSpec::HalfCar(HalfCarParams::from_roll_plane(&p, 1.8, 180.0));
+            s.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(HalfCarParams::from_roll_plane(&p, 1.8, 180.0)));
             s.trailing = vec![TrailingWheelset {
                 offset: 1.8,
                 ..Default::default()

@@ -60,8 +60,8 @@ pub struct Simulation {
     pub(super) simd: SimdLevel,
     /// The observation points ([`Scenario::sites`]).
     pub(super) sites: Vec<Site>,
-    /// The vehicle that moves several wheelsets' wheels ([`VehicleSpec::HalfCar`],
-    /// [`VehicleSpec::Wagon`]), behind one interface.
+    /// The vehicle that moves several wheelsets' wheels ([`VehicleSpec::Carrier`]: the
+    /// half-car bogie, the wagons), behind one interface.
     pub(super) carrier: Option<Box<dyn RailVehicle>>,
     /// The first two wheelsets' axle boxes under the same side frames
     /// ([`crate::sim::SideFrameSpec::HalfCar`]).
@@ -470,9 +470,8 @@ impl Simulation {
         Ok(())
     }
 
-    /// The vehicle that carries several wheelsets (the half-car bogie, the wagon),
-    /// when there is one ([`crate::sim::VehicleSpec::HalfCar`],
-    /// [`crate::sim::VehicleSpec::Wagon`]).
+    /// The vehicle that carries several wheelsets (the half-car bogie, the wagons),
+    /// when there is one ([`crate::sim::VehicleSpec::Carrier`]).
     pub fn carrier(&self) -> Option<&dyn RailVehicle> {
         self.carrier.as_deref()
     }
