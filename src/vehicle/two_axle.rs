@@ -520,7 +520,10 @@ mod tests {
         // effective mass: Jacobi 18.4 ms, sequential 20.3 ms.
         assert!((m - 14_671.0).abs() < 1.0, "{m}");
         assert!(none.jacobi > 10e-3 && none.sequential > 10e-3, "{none:?}");
-        assert!(massive.jacobi > 1e-3 && massive.sequential > 1e-3, "{massive:?}");
+        assert!(
+            massive.jacobi > 1e-3 && massive.sequential > 1e-3,
+            "{massive:?}"
+        );
     }
 
     #[test]
