@@ -13,7 +13,7 @@
 //!   (`Simulation::primary_force_of`, TrackContact's `primary.*.force`).
 //!
 //! Printed per vehicle, master and step: each wheel's peak error against the monolithic
-//! run (`VehicleSpec::RollPlane`, `VehicleSpec::HalfCar`) and the largest difference of
+//! run (`VehicleSpec::RollPlane`, `CarrierSpec::HalfCar`) and the largest difference of
 //! the contact-force histories over the static load, or where it diverged.
 //! `cargo run --release --example axle_box_masters [duration_s] [--limits]`: with
 //! `--limits`, the largest usable step per master over primary stiffnesses and dampings.
@@ -21,9 +21,19 @@ use wheelflat::sim::{
     Scenario, SideFrameSpec, Simulation, TrackWindow, TrailingWheelset, VehicleSpec,
 };
 use wheelflat::vehicle::{
-    CONTACT_STIFFNESS, ExchangeLimits, HalfCarParams, Quad, RollPlaneParams, SprungBogie,
-    SprungHalfCar,
+    Axles, CONTACT_STIFFNESS, CarrierSpec, ExchangeLimits, HalfCarParams, Quad, RollPlaneParams,
+    SprungBogie, SprungHalfCar, SprungVehicle,
 };
+
+/// `q` as the half-car's wheelsets of a vehicle's [`Axles`].
+fn axles(q: Quad) -> Axles {
+    [q[0], q[1], [0.0; 2], [0.0; 2]]
+}
+
+/// The first two wheelsets of `a`.
+fn quad(a: &Axles) -> Quad {
+    [a[0], a[1]]
+}
 
 /// The bodies above the primary suspension.
 #[allow(clippy::large_enum_variant)]
@@ -36,7 +46,7 @@ impl Above {
     fn step(&mut self, f: Quad) {
         match self {
             Above::RollPlane(b) => b.step(f[0]),
-            Above::HalfCar(b) => b.step(f),
+            Above::HalfCar(b) => b.step(&axles(f)),
         }
     }
     fn side_frames(&self) -> (Quad, Quad) {
@@ -45,7 +55,10 @@ impl Above {
                 let (z, v) = b.side_frames();
                 ([z, [0.0; 2]], [v, [0.0; 2]])
             }
-            Above::HalfCar(b) => b.side_frames(),
+            Above::HalfCar(b) => {
+                let (z, v) = b.side_frames();
+                (quad(&z), quad(&v))
+            }
         }
     }
     fn diverged(&self) -> bool {
@@ -102,7 +115,7 @@ impl Case {
         let (wheelbase, pitch_inertia) = (1.8, 180.0);
         let h_params = HalfCarParams::from_roll_plane(&p, wheelbase, pitch_inertia);
         if half_car {
-            mono.vehicle = VehicleSpec::HalfCar(h_params);
+            mono.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(h_params));
             mono.trailing = vec![TrailingWheelset {
                 offset: wheelbase,
                 ..Default::default()
@@ -167,7 +180,7 @@ impl Case {
         let boxes: Quad = [0, 1].map(|k| sim.primary_of(k).map_or([0.0; 2], |p| p.1));
         let mut above = if self.half_car {
             let mut b = SprungHalfCar::new(self.h_params, hs).map_err(|e| e.to_string())?;
-            b.set_static(boxes).unwrap();
+            b.set_static(&axles(boxes)).unwrap();
             Above::HalfCar(b)
         } else {
             let mut b = SprungBogie::new(self.p, hs).map_err(|e| e.to_string())?;
@@ -227,8 +240,9 @@ impl Case {
         let base = (5e-4f64).min(0.4 * self.critical());
         if self.half_car {
             let mut b = SprungHalfCar::new(self.h_params, base).unwrap();
-            b.set_static(boxes).unwrap();
-            b.exchange_limits(boxes, base, CONTACT_STIFFNESS).unwrap()
+            b.set_static(&axles(boxes)).unwrap();
+            b.exchange_limits(&axles(boxes), base, CONTACT_STIFFNESS)
+                .unwrap()
         } else {
             let mut b = SprungBogie::new(self.p, base).unwrap();
             b.set_static(boxes[0]).unwrap();

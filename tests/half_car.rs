@@ -3,7 +3,7 @@
 //! impact against the roll-plane vehicle.
 
 use wheelflat::sim::{Scenario, Simulation, TrackWindow, TrailingWheelset, VehicleSpec};
-use wheelflat::vehicle::{HalfCarParams, RollPlaneParams};
+use wheelflat::vehicle::{CarrierSpec, HalfCarParams, RollPlaneParams};
 
 fn roll_plane(s: &Scenario) -> RollPlaneParams {
     match s.vehicle {
@@ -17,7 +17,9 @@ fn roll_plane(s: &Scenario) -> RollPlaneParams {
 fn half_car_scenario() -> Scenario {
     let mut s = Scenario::table_4_4_flat();
     let p = roll_plane(&s);
-    s.vehicle = VehicleSpec::HalfCar(HalfCarParams::from_roll_plane(&p, 1.8, 90.0));
+    s.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(HalfCarParams::from_roll_plane(
+        &p, 1.8, 90.0,
+    )));
     s.trailing = vec![TrailingWheelset {
         offset: 1.8,
         ..Default::default()

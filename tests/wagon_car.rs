@@ -6,7 +6,7 @@
 use wheelflat::sim::{
     Scenario, Simulation, UnitModel, VehicleSpec, VehicleUnit, VehicleUnitParams,
 };
-use wheelflat::vehicle::{HalfCarParams, RollPlaneParams};
+use wheelflat::vehicle::{CarrierSpec, HalfCarParams, RollPlaneParams};
 
 fn roll_plane(s: &Scenario) -> RollPlaneParams {
     match s.vehicle {
@@ -109,20 +109,20 @@ fn the_wagon_with_the_dumbbell_pitch_inertia_is_two_half_cars_on_the_track() {
     // the same track (measured: 0.41 % at most, 0.01 % on the flat wheel), and the
     // wagon's largest peak is the flat wheel's.
     let mut s = wagon_scenario();
-    let VehicleSpec::Wagon(mut w) = s.vehicle else {
+    let VehicleSpec::Carrier(CarrierSpec::Wagon(mut w)) = s.vehicle else {
         unreachable!()
     };
     let (m, _, _) = w.body_with_bolsters();
     let hd = 0.5 * w.bogie_distance;
     w.carbody_pitch_inertia = m * hd * hd - 2.0 * w.bogie.bolster_mass * hd * hd;
-    s.vehicle = VehicleSpec::Wagon(w);
+    s.vehicle = VehicleSpec::Carrier(CarrierSpec::Wagon(w));
     let wagon = peaks(&mut Simulation::new(&s).unwrap(), 0.2);
     let mut h = s.clone();
     let bogie = HalfCarParams {
         carbody_mass: 0.5 * w.carbody_mass,
         ..w.bogie
     };
-    h.vehicle = VehicleSpec::HalfCar(bogie);
+    h.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(bogie));
     h.trailing.truncate(1);
     let half = peaks(&mut Simulation::new(&h).unwrap(), 0.2);
     for k in 0..2 {
@@ -142,7 +142,7 @@ fn the_wagon_unit_with_external_wheels_at_the_tracks_step_is_the_monolithic_run(
     // exchanged at every track step in the order of docs/MODEL.md, do the monolithic
     // run's arithmetic: the eight contact forces agree bit for bit through the impact.
     let s = wagon_scenario();
-    let VehicleSpec::Wagon(w) = s.vehicle else {
+    let VehicleSpec::Carrier(CarrierSpec::Wagon(w)) = s.vehicle else {
         unreachable!()
     };
     let mut mono = Simulation::new(&s).unwrap();
@@ -159,7 +159,7 @@ fn the_wagon_unit_with_external_wheels_at_the_tracks_step_is_the_monolithic_run(
         dt: track.dt(),
         static_wheel_z: z(0),
         axle_box: false,
-        model: UnitModel::Wagon(w),
+        model: UnitModel::Carrier(CarrierSpec::Wagon(w)),
         trailing_static_wheel_z: [z(1), z(2), z(3)],
     })
     .unwrap();

@@ -1,12 +1,13 @@
 //! The stability of the axle-box exchange: the bodies above the primary suspension
-//! ([`SprungBogie`], [`SprungHalfCar`]) exchange with a track that carries the wheelsets
-//! and moves the side frames on under their own inertia over each step
-//! ([`super::PrimaryLink`]), every communication step `h`. The exchange is explicit: the
-//! bogie holds the primary forces the track computed over the step (the mean of the step
-//! under a sequential master, the force at the communication point under a Jacobi
-//! master, which hands it on one step later). Springs and dampers both enter it.
+//! ([`SprungBogie`], a [`SprungLinearBody`] such as [`super::SprungHalfCar`]) exchange
+//! with a track that carries the wheelsets and moves the side frames on under their own
+//! inertia over each step ([`super::PrimaryLink`]), every communication step `h`. The
+//! exchange is explicit: the bogie holds the primary forces the track computed over the
+//! step (the mean of the step under a sequential master, the force at the communication
+//! point under a Jacobi master, which hands it on one step later). Springs and dampers
+//! both enter it.
 //!
-//! [`exchange_limits`] estimates the largest stable `h` of each master kind from the
+//! [`SprungVehicle::exchange_limits`] estimates the largest stable `h` of each master kind from the
 //! spectral radius of the exchange's amplification matrix: the linear map of one
 //! communication step, perturbations about the static state, of the bogie's state
 //! (with its own substeps), the side frames the track carries, and the forces the
@@ -19,9 +20,7 @@
 use super::MAX_AXLES;
 use super::linear_body::{LinearVehicle, SprungLinearBody};
 use super::rail_vehicle::{Axles, SprungVehicle};
-use super::{
-    HalfCarParams, PrimaryLink, Quad, RollPlaneParams, SideFrameInertia, SprungBogie, SprungHalfCar,
-};
+use super::{PrimaryLink, RollPlaneParams, SideFrameInertia, SprungBogie};
 use crate::error::Result;
 use nalgebra::DMatrix;
 
@@ -31,8 +30,8 @@ const TRACK_STEP: f64 = 14.4e-6;
 /// The bodies above the primary suspension, as the exchange sees them: forces in and
 /// side-frame motion out at each axle box.
 trait SprungBody: Clone {
-    /// Axle boxes: 2 (roll-plane vehicle) or 4 (half-car bogie, wheelset by wheelset,
-    /// left then right).
+    /// Axle boxes: 2 (roll-plane vehicle) or two per wheelset (a linear vehicle, such
+    /// as the half-car bogie's 4, wheelset by wheelset, left then right).
     fn boxes(&self) -> usize;
     /// The side frames' displacements and velocities at the axle boxes (m, m/s).
     fn frames(&self) -> (Vec<f64>, Vec<f64>);
@@ -67,29 +66,6 @@ impl SprungBody for SprungBogie {
     }
     fn set_step(&mut self, dt: f64) {
         // At most the base step, which the bogie accepted.
-        let _ = self.change_dt(dt);
-    }
-}
-
-impl SprungBody for SprungHalfCar {
-    fn boxes(&self) -> usize {
-        4
-    }
-    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
-        let (z, v) = self.side_frames();
-        (z.concat(), v.concat())
-    }
-    fn step_boxes(&mut self, f: &[f64]) {
-        let q: Quad = [[f[0], f[1]], [f[2], f[3]]];
-        self.step(q);
-    }
-    fn state(&self) -> Vec<f64> {
-        self.state_vector()
-    }
-    fn set_state(&mut self, v: &[f64]) {
-        let _ = self.set_state_vector(v);
-    }
-    fn set_step(&mut self, dt: f64) {
         let _ = self.change_dt(dt);
     }
 }
@@ -382,43 +358,5 @@ impl SprungBogie {
         let inertia = SideFrameInertia::single(p.sideframe_mass);
         let track = track_side(self, &p, inertia, &z_box, support)?;
         Ok(limits_of(self, &track, base))
-    }
-}
-
-impl SprungHalfCar {
-    /// [`ExchangeLimits`] of this bogie at rest with its axle boxes at `z_box` (m), as
-    /// [`SprungBogie::exchange_limits`], its pitching side frames shared by the two
-    /// wheelsets.
-    ///
-    /// Errors: a parameter [`PrimaryLink::new`] refuses.
-    pub fn exchange_limits(&self, z_box: Quad, base: f64, support: f64) -> Result<ExchangeLimits> {
-        let h = self.params();
-        let track = track_side(self, &wheelset_of(h), pitching(h), &z_box.concat(), support)?;
-        Ok(limits_of(self, &track, base))
-    }
-}
-
-/// The pitching side frames of a half-car bogie `h`.
-fn pitching(h: &HalfCarParams) -> SideFrameInertia {
-    SideFrameInertia::pitching(h.sideframe_mass, h.sideframe_pitch_inertia, h.wheelbase)
-}
-
-/// The wheelset and primary suspension of a half-car bogie `h` only ([`PrimaryLink`]
-/// uses no more).
-fn wheelset_of(h: &HalfCarParams) -> RollPlaneParams {
-    RollPlaneParams {
-        carbody_mass: 0.0,
-        bolster_mass: 0.0,
-        bolster_inertia: 0.0,
-        sideframe_mass: 0.0,
-        wheelset_mass: h.wheelset_mass,
-        wheelset_inertia: h.wheelset_inertia,
-        primary_stiffness: h.primary_stiffness,
-        primary_damping: h.primary_damping,
-        primary_spacing: h.primary_spacing,
-        secondary_stiffness: 0.0,
-        secondary_damping: 0.0,
-        secondary_spacing: 0.0,
-        gravity: h.gravity,
     }
 }

@@ -12,10 +12,8 @@
 //! `[left, right]`, in an [`Axles`] of which the first [`RailVehicle::wheelsets`] are
 //! used.
 
-use super::{ExchangeLimits, HalfCarBogie, SprungHalfCar};
+use super::ExchangeLimits;
 use crate::error::Result;
-use crate::limits::{BODY_DISPLACEMENT_LIMIT, DISPLACEMENT_LIMIT, within};
-use crate::numerics::CentralDifference;
 
 /// Most wheelsets one vehicle rests on (the wagon's four).
 pub const MAX_AXLES: usize = 4;
@@ -68,36 +66,6 @@ pub trait CarrierModel {
     ///
     /// Errors: as [`CarrierModel::whole`].
     fn sprung(&self, dt: f64) -> Result<Box<dyn SprungVehicle>>;
-}
-
-impl CarrierModel for super::HalfCarParams {
-    fn wheelsets(&self) -> usize {
-        2
-    }
-    fn offsets(&self) -> Vec<(f64, &'static str)> {
-        vec![(self.wheelbase, "the wheelbase")]
-    }
-    fn name(&self) -> &'static str {
-        "the half-car bogie (vehicle.model = half_car)"
-    }
-    fn validate(&self) -> Result<()> {
-        super::HalfCarParams::validate(self)
-    }
-    fn critical_time_step(&self) -> f64 {
-        super::HalfCarParams::critical_time_step(self)
-    }
-    fn default_dt(&self) -> f64 {
-        super::HalfCarParams::default_dt(self)
-    }
-    fn static_wheel_load(&self) -> f64 {
-        super::HalfCarParams::static_wheel_load(self)
-    }
-    fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
-        Ok(Box::new(HalfCarBogie::new(*self, dt)?))
-    }
-    fn sprung(&self, dt: f64) -> Result<Box<dyn SprungVehicle>> {
-        Ok(Box::new(SprungHalfCar::new(*self, dt)?))
-    }
 }
 
 /// A whole vehicle on several wheelsets, driven by the contact forces of its wheels.
@@ -194,159 +162,5 @@ pub trait SprungVehicle: std::fmt::Debug + Send + Sync {
 impl Clone for Box<dyn SprungVehicle> {
     fn clone(&self) -> Self {
         self.clone_box()
-    }
-}
-
-/// The first value of `cd` at `t_j` or `t_(j-1)` beyond [`BODY_DISPLACEMENT_LIMIT`],
-/// named by `names` (a degree of freedom's index to its name): the bodies' health
-/// check of every vehicle on several wheelsets.
-pub(super) fn bodies_beyond<const N: usize>(
-    cd: &CentralDifference<N>,
-    names: impl Fn(usize) -> &'static str,
-) -> Option<(&'static str, f64, f64)> {
-    cd.d()
-        .iter()
-        .chain(cd.d_prev().iter())
-        .enumerate()
-        .map(|(i, &x)| (names(i % N), x, BODY_DISPLACEMENT_LIMIT))
-        .find(|&(_, x, l)| !within(x, l))
-}
-
-/// The first wheel centre of the first `wheelsets` of `z` (m) beyond
-/// [`DISPLACEMENT_LIMIT`], named as the FMUs name it.
-pub(super) fn wheels_beyond(z: &Axles, wheelsets: usize) -> Option<(&'static str, f64, f64)> {
-    const WHEELS: [&str; 2 * MAX_AXLES] = [
-        "wheel.left.z (m)",
-        "wheel.right.z (m)",
-        "wheelset[2].wheel.left.z (m)",
-        "wheelset[2].wheel.right.z (m)",
-        "wheelset[3].wheel.left.z (m)",
-        "wheelset[3].wheel.right.z (m)",
-        "wheelset[4].wheel.left.z (m)",
-        "wheelset[4].wheel.right.z (m)",
-    ];
-    WHEELS
-        .into_iter()
-        .zip(z.iter().take(wheelsets).flatten())
-        .map(|(n, &x)| (n, x, DISPLACEMENT_LIMIT))
-        .find(|&(_, x, l)| !within(x, l))
-}
-
-/// The first two wheelsets of `a`.
-fn pair(a: &Axles) -> super::Quad {
-    [a[0], a[1]]
-}
-
-/// `q` as the first two wheelsets.
-pub(super) fn axles(q: super::Quad) -> Axles {
-    [q[0], q[1], [0.0; 2], [0.0; 2]]
-}
-
-/// The half-car bogie's bodies of its displacements `d` (in the order of
-/// [`super::HALF_CAR_DOF_NAMES`]).
-fn half_car_bodies(d: &super::HalfCarVector) -> Bodies {
-    let bolster = [d[0], d[1]];
-    let pitch = [d[3], d[5]];
-    Bodies {
-        carbody: [0.0; 3],
-        bolster: axles([bolster, bolster]),
-        sideframe_pitch: axles([pitch, pitch]),
-        wheelset: axles([[d[6], d[7]], [d[8], d[9]]]),
-    }
-}
-
-impl RailVehicle for HalfCarBogie {
-    fn wheelsets(&self) -> usize {
-        2
-    }
-    fn dt(&self) -> f64 {
-        HalfCarBogie::dt(self)
-    }
-    fn critical_time_step(&self) -> f64 {
-        self.params().critical_time_step()
-    }
-    fn wheel_z(&self) -> Axles {
-        axles(HalfCarBogie::wheel_z(self))
-    }
-    fn wheel_velocities(&self) -> Axles {
-        axles(HalfCarBogie::wheel_velocities(self))
-    }
-    fn bearing_forces(&self) -> Axles {
-        axles(HalfCarBogie::bearing_forces(self))
-    }
-    fn side_frames(&self) -> (Axles, Axles) {
-        let (z, v) = HalfCarBogie::side_frames(self);
-        (axles(z), axles(v))
-    }
-    fn displacements(&self) -> &[f64] {
-        HalfCarBogie::displacements(self).as_slice()
-    }
-    fn bodies(&self) -> Bodies {
-        half_car_bodies(HalfCarBogie::displacements(self))
-    }
-    fn step(&mut self, p: &Axles) {
-        HalfCarBogie::step(self, pair(p))
-    }
-    fn set_static(&mut self, z: &Axles) -> Result<Axles> {
-        HalfCarBogie::set_static(self, pair(z))?;
-        Ok(axles(
-            self.params()
-                .static_contact_forces(HalfCarBogie::displacements(self)),
-        ))
-    }
-    fn change_dt(&mut self, dt: f64) -> Result<()> {
-        HalfCarBogie::change_dt(self, dt)
-    }
-    fn state_vector(&self) -> Vec<f64> {
-        HalfCarBogie::state_vector(self)
-    }
-    fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        HalfCarBogie::set_state_vector(self, v)
-    }
-    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        HalfCarBogie::beyond_bounds(self)
-    }
-    fn clone_box(&self) -> Box<dyn RailVehicle> {
-        Box::new(self.clone())
-    }
-}
-
-impl SprungVehicle for SprungHalfCar {
-    fn wheelsets(&self) -> usize {
-        2
-    }
-    fn critical_time_step(&self) -> f64 {
-        self.params().critical_time_step()
-    }
-    fn side_frames(&self) -> (Axles, Axles) {
-        let (z, v) = SprungHalfCar::side_frames(self);
-        (axles(z), axles(v))
-    }
-    fn bodies(&self) -> Bodies {
-        half_car_bodies(&self.whole_displacements())
-    }
-    fn step(&mut self, f: &Axles) {
-        SprungHalfCar::step(self, pair(f))
-    }
-    fn set_static(&mut self, z: &Axles) -> Result<Axles> {
-        SprungHalfCar::set_static(self, pair(z)).map(axles)
-    }
-    fn change_dt(&mut self, dt: f64) -> Result<()> {
-        SprungHalfCar::change_dt(self, dt)
-    }
-    fn state_vector(&self) -> Vec<f64> {
-        SprungHalfCar::state_vector(self)
-    }
-    fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        SprungHalfCar::set_state_vector(self, v)
-    }
-    fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
-        SprungHalfCar::beyond_bounds(self)
-    }
-    fn exchange_limits(&self, z: &Axles, base: f64, support: f64) -> Result<ExchangeLimits> {
-        SprungHalfCar::exchange_limits(self, pair(z), base, support)
-    }
-    fn clone_box(&self) -> Box<dyn SprungVehicle> {
-        Box::new(self.clone())
     }
 }

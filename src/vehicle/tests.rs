@@ -11,6 +11,11 @@ fn table_4_4() -> RollPlaneParams {
     }
 }
 
+/// `q` as the first two wheelsets of a vehicle's [`Axles`].
+fn axles(q: Quad) -> Axles {
+    [q[0], q[1], [0.0; 2], [0.0; 2]]
+}
+
 #[test]
 fn static_wheel_load_is_seeds_107_6_kn() {
     let w = table_4_4().static_wheel_load();
@@ -232,7 +237,7 @@ fn half_car_driven_alike_on_both_wheelsets_moves_as_the_roll_plane_vehicle() {
     let mut bogie = HalfCarBogie::new(h, dt).unwrap();
     let mut roll = RollPlaneVehicle::new(rp, dt).unwrap();
     let z = [-1.2e-3, -1.4e-3];
-    bogie.set_static([z, z]).unwrap();
+    bogie.set_static(&axles([z, z])).unwrap();
     roll.set_static(z).unwrap();
     let w = rp.static_wheel_load();
     let (mut worst, mut motion): (f64, f64) = (0.0, 0.0);
@@ -246,7 +251,7 @@ fn half_car_driven_alike_on_both_wheelsets_moves_as_the_roll_plane_vehicle() {
             0.0
         };
         let p = [w + pulse, w - 3e4 * (50.0 * t).sin()];
-        bogie.step([p, p]);
+        bogie.step(&axles([p, p]));
         roll.step(p);
         let (b, r) = (bogie.displacements(), roll.displacements());
         for (x, y) in [
@@ -285,9 +290,9 @@ fn sprung_half_car_against_the_whole(dt: f64) -> (f64, f64) {
     let h = HalfCarParams::from_roll_plane(&table_4_4(), 1.8, 90.0);
     let mut whole = HalfCarBogie::new(h, dt).unwrap();
     let mut above = SprungHalfCar::new(h, dt).unwrap();
-    let z = [[-1.2e-3, -1.3e-3], [-1.1e-3, -1.25e-3]];
-    whole.set_static(z).unwrap();
-    let f0 = above.set_static(z).unwrap();
+    let z = axles([[-1.2e-3, -1.3e-3], [-1.1e-3, -1.25e-3]]);
+    whole.set_static(&z).unwrap();
+    let f0 = above.set_static(&z).unwrap();
     let fw = whole.bearing_forces();
     for k in 0..2 {
         for s in 0..2 {
@@ -307,8 +312,8 @@ fn sprung_half_car_against_the_whole(dt: f64) -> (f64, f64) {
             [w, w - 5e4 * (80.0 * t).cos()],
         ];
         // The whole bogie's primary forces at t_j drive the part above them.
-        above.step(whole.bearing_forces());
-        whole.step(p);
+        above.step(&whole.bearing_forces());
+        whole.step(&axles(p));
         let (a, b) = (above.displacements(), whole.displacements());
         for i in 0..6 {
             worst = worst.max((a[i] - b[i]).abs());

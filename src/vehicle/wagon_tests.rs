@@ -12,6 +12,16 @@ fn wagon() -> WagonParams {
     WagonParams::table_4_4(&p, 10.0, 1.8, 100.0)
 }
 
+/// `o` wheelset by wheelset, as a vehicle's [`Axles`].
+fn flat(o: Octet) -> Axles {
+    [o[0][0], o[0][1], o[1][0], o[1][1]]
+}
+
+/// `q` as the first two wheelsets of a vehicle's [`Axles`].
+fn first_two(q: Quad) -> Axles {
+    [q[0], q[1], [0.0; 2], [0.0; 2]]
+}
+
 #[test]
 fn natural_frequencies_are_the_general_eigenvalues_of_m_inverse_k() {
     let w = wagon();
@@ -218,17 +228,17 @@ fn at_a_standstill_the_wagon_stays_in_its_static_state() {
     // has rigid modes, which the rounding of the forces' balance drives), the
     // acceleration that takes below 1e-8 g.
     let w = wagon();
-    let dt = 0.5 * w.critical_time_step();
+    let dt = 0.5 * LinearVehicle::critical_time_step(&w);
     let mut v = Wagon::new(w, dt).unwrap();
     let z = [
         [[-1.0e-3, -1.2e-3], [-1.1e-3, -0.9e-3]],
         [[-1.0e-3, -1.0e-3], [-0.8e-3, -1.3e-3]],
     ];
-    v.set_static(z).unwrap();
+    v.set_static(&flat(z)).unwrap();
     let start = *v.displacements();
-    let p = w.static_contact_forces(&start);
+    let p = flat(w.static_contact_forces(&start));
     for _ in 0..20_000 {
-        v.step(p);
+        v.step(&p);
     }
     let drift = (v.displacements() - start).amax();
     let t = 20_000.0 * dt;
@@ -251,16 +261,16 @@ fn in_time_the_wagon_moves_as_two_half_car_bogies_under_loads_that_roll_neither(
         bolster_inertia: 0.5 * jr,
         ..w.bogie
     };
-    let dt = 0.5 * w.critical_time_step().min(half.critical_time_step());
+    let dt = 0.5 * LinearVehicle::critical_time_step(&w).min(half.critical_time_step());
     let mut wagon = Wagon::new(w, dt).unwrap();
     let mut pair = [
         HalfCarBogie::new(half, dt).unwrap(),
         HalfCarBogie::new(half, dt).unwrap(),
     ];
     let z = [[[-1e-3; 2]; 2]; 2];
-    wagon.set_static(z).unwrap();
+    wagon.set_static(&flat(z)).unwrap();
     for b in &mut pair {
-        b.set_static(z[0]).unwrap();
+        b.set_static(&first_two(z[0])).unwrap();
     }
     let load = w.static_wheel_load();
     let t = to_pair(hd);
@@ -274,9 +284,9 @@ fn in_time_the_wagon_moves_as_two_half_car_bogies_under_loads_that_roll_neither(
             [x, x]
         };
         let p: Octet = [0, 1].map(|b| [0, 1].map(|i| f(b, i)));
-        wagon.step(p);
+        wagon.step(&flat(p));
         for (b, bogie) in pair.iter_mut().enumerate() {
-            bogie.step(p[b]);
+            bogie.step(&first_two(p[b]));
         }
         let mapped = &t * DVector::from_iterator(WAGON_DOFS, wagon.displacements().iter().copied());
         for b in 0..2 {
