@@ -1,6 +1,6 @@
 """Builds the wheelflat wheel from this checkout (see pyproject.toml): the Python
 package plus, under ``wheelflat_study/_data``, the case runner (``bin/wheelflat_case``),
-the five FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs, the
+the FMUs (``fmu/``) and ``build.json``, the record of their versions and GUIDs, the
 newest glibc symbol version they need and the git commit. Both come from the one build
 of the FMUs, scripts/build_fmus_glibc228.sh (the README's main command's), against the
 glibc 2.28 baseline (quick when up to date; it packs fmu/ again); the wheel is refused

@@ -12,7 +12,7 @@ asks for; a study started again skips the cases it already has.
     wheelflat-study studies/speed_flat.toml [--scheduler ADDRESS] [--workers N]
 
 Installed from its wheel (``python/pyproject.toml``), the package carries its own case
-runner and the five FMUs (``fmu_paths()``), so a cluster's worker needs only the
+runner and the FMUs (``fmu_paths()``), so a cluster's worker needs only the
 install. See docs/guide/studies.md and docs/STUDIES.md.
 """
 

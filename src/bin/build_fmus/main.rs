@@ -1,4 +1,4 @@
-//! Packs the three FMUs: `fmu/<modelIdentifier>.fmu` with the generated
+//! Packs the FMUs: `fmu/<modelIdentifier>.fmu` with the generated
 //! modelDescription.xml, the crate's shared library as
 //! `binaries/<platform>/<modelIdentifier>.so` and the generated
 //! `documentation/index.html` (build/documentation.rs); writes the C header of the

@@ -1,4 +1,4 @@
-//! The model behind each of the three FMUs, as the FMI 2.0 layer sees it: building
+//! The model behind each FMU, as the FMI 2.0 layer sees it: building
 //! from the variables, inputs (taken in `inputs.rs`), stepping on the model's own
 //! grid, health checks of the outputs, and the state vector of FMU states.
 
