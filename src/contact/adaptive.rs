@@ -3,8 +3,8 @@
 //! over the whole patch, else by bracketing the sign changes of the integrand and
 //! integrating each contact interval by Gauss-Legendre quadrature.
 
-use super::law::ContactState;
 use super::perfect::{perfect_patch_scaled, sin_minus_x};
+use super::state::ContactState;
 use crate::numerics::{
     LANES, SMALL_ANGLE, SimdLevel, cos_poly, cos_small, gauss_legendre, inlined, refine_root,
     sliver, wrap_angle,

@@ -1,8 +1,9 @@
 //! The contact law behind one interface: which law ([`ContactModel`]), its constants
-//! ([`ContactLaw`]), what it reports ([`ContactState`]), the dispatch to each law, and
-//! what every law gets from the dispatch: its stiffness and the overlap that carries a
-//! force.
+//! ([`ContactLaw`]), the dispatch to each law, and what every law gets from the
+//! dispatch: its stiffness and the overlap that carries a force. What a law reports
+//! ([`ContactState`]) is in `state.rs`.
 
+use super::state::ContactState;
 use super::{adaptive, hertz};
 use crate::error::{Result, positive};
 use crate::wheel::WheelProfile;
@@ -25,32 +26,6 @@ pub struct ContactLaw {
     pub kw: f64,
     /// Hertz coefficient `C_H` (N/m^1.5), used by the Hertz law.
     pub ch: f64,
-}
-
-/// What the contact model reports for one wheel at one instant.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ContactState {
-    /// Normal contact force `P` (N), >= 0, pushes the wheel up and the rail down.
-    pub force: f64,
-    /// Overlap `delta_c = z_rail - z_wheel` (m) (2.7); negative when apart.
-    pub overlap: f64,
-    /// Front contact angle `alpha_f` (rad), the foremost compressed spring (2.22);
-    /// 0 when out of contact.
-    pub front_angle: f64,
-    /// Rear contact angle `alpha_r` (rad), the rearmost compressed spring (2.22).
-    pub rear_angle: f64,
-    /// Contact length along the rail between the rear and front contact points (m),
-    /// `h (tan alpha_f - tan alpha_r)`.
-    pub length: f64,
-    /// Number of separate contact intervals (0: loss of contact, 2 or more: split patch).
-    pub intervals: u32,
-}
-
-impl ContactState {
-    /// True when the wheel has lost contact with the rail.
-    pub fn lost(&self) -> bool {
-        self.intervals == 0
-    }
 }
 
 impl ContactLaw {
@@ -103,7 +78,7 @@ impl ContactLaw {
     pub fn stiffness_at(&self, wheel: &WheelProfile, gamma: f64, overlap: f64) -> f64 {
         match self.model {
             ContactModel::Adaptive => adaptive::adaptive_stiffness(self.kw, wheel, gamma, overlap),
-            ContactModel::Hertz => hertz::hertz_stiffness(self, wheel, gamma, overlap),
+            ContactModel::Hertz => hertz::hertz_stiffness(self.ch, wheel, gamma, overlap),
         }
     }
 
@@ -135,7 +110,7 @@ impl ContactLaw {
             ContactModel::Adaptive => {
                 adaptive::adaptive(self.kw, wheel, gamma, overlap, false, out)
             }
-            ContactModel::Hertz => *out = hertz::hertz(self, wheel, gamma, overlap),
+            ContactModel::Hertz => *out = hertz::hertz(self.ch, wheel, gamma, overlap),
         }
     }
 
@@ -156,8 +131,11 @@ impl ContactLaw {
                 adaptive::adaptive_and_stiffness(self.kw, wheel, gamma, overlap, out)
             }
             ContactModel::Hertz => {
-                *out = hertz::hertz(self, wheel, gamma, overlap);
-                (hertz::hertz_stiffness(self, wheel, gamma, overlap), false)
+                *out = hertz::hertz(self.ch, wheel, gamma, overlap);
+                (
+                    hertz::hertz_stiffness(self.ch, wheel, gamma, overlap),
+                    false,
+                )
             }
         }
     }

@@ -18,10 +18,12 @@ mod calibration;
 mod hertz;
 mod law;
 mod perfect;
+mod state;
 #[cfg(test)]
 mod tests;
 
 pub use adaptive::adaptive_numeric;
 pub use calibration::kw_from_hertz;
-pub use law::{ContactLaw, ContactModel, ContactState};
+pub use law::{ContactLaw, ContactModel};
 pub use perfect::{patch_angle, perfect_wheel_force};
+pub use state::ContactState;
