@@ -5,6 +5,7 @@
 mod datum;
 mod derivatives;
 mod inputs;
+mod model;
 mod outputs;
 mod parameters;
 mod unit;
@@ -12,7 +13,8 @@ mod warnings;
 mod watch;
 
 pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};
-pub use unit::{END_ZONE_SPANS, FmuModel};
+pub use unit::FmuModel;
+pub use warnings::END_ZONE_SPANS;
 
 use crate::fmu::vars::{self, FmuTable};
 use crate::vehicle::{VEHICLE_KINDS, VehicleKind};

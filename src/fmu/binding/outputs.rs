@@ -3,48 +3,10 @@
 use super::FmuModel;
 use super::unit::Engine;
 use crate::contact::ContactState;
-use crate::fmu::vars::{QUANTITIES, Quantity, TRAILING};
+use crate::fmu::vars::{QUANTITIES, Quantity};
 use crate::sim::VehicleUnit;
 use crate::sim::{Sample, Simulation, VehicleState};
 use crate::track::RailResponse;
-
-/// Values computed when the model is built, published as calculated parameters.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Published {
-    /// `static_load.left`/`.right` (N).
-    pub static_load: [f64; 2],
-    /// `static_wheel_z.left`/`.right` (m).
-    pub static_wheel_z: [f64; 2],
-    /// `wheelset[k].static_wheel_z.left`/`.right` (m), k = 2, 3, .. (0 for a wheelset
-    /// the model does not have).
-    pub trailing_static_wheel_z: [[f64; 2]; TRAILING],
-    /// `solver.step` (s).
-    pub step: f64,
-    /// `solver.critical_step` (s).
-    pub critical_step: f64,
-    /// `contact.kw_used` (N/m/rad).
-    pub kw_used: f64,
-}
-
-impl Published {
-    /// Number of values in [`Published::to_array`].
-    pub const LEN: usize = 7 + 2 * TRAILING;
-
-    /// The values in the order FMU states store them.
-    pub fn to_array(self) -> [f64; Self::LEN] {
-        let [l, r] = self.static_load;
-        let [zl, zr] = self.static_wheel_z;
-        let mut a = [0.0; Self::LEN];
-        a[..7].copy_from_slice(&[l, r, zl, zr, self.step, self.critical_step, self.kw_used]);
-        for (pair, z) in a[7..]
-            .chunks_exact_mut(2)
-            .zip(&self.trailing_static_wheel_z)
-        {
-            pair.copy_from_slice(z);
-        }
-        a
-    }
-}
 
 /// What the outputs are read from.
 enum View<'a> {

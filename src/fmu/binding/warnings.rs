@@ -3,11 +3,16 @@
 //! contact watch sees, a vehicle's first step off its forces at rest.
 
 use super::Kind;
-use super::unit::{END_ZONE_SPANS, Engine, FmuModel};
+use super::unit::{Engine, FmuModel};
 use super::watch::{HELD_STEPS, INTERPOLATED_STEPS};
 use crate::error::num;
 use crate::fmu::fmi2::StepWarning;
 use crate::sim::{TrackSpec, VehicleState, VehicleUnit};
+
+/// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
+/// end's reflections raise the forces (the default start position, 1.37 m, is two
+/// spans from the other end).
+pub const END_ZONE_SPANS: f64 = 2.0;
 
 impl FmuModel {
     /// When the wheel is within [`END_ZONE_SPANS`] sleeper spans of the fixed rail end,
