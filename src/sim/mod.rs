@@ -7,6 +7,7 @@ mod accelerations;
 mod build;
 mod checks;
 mod clock;
+mod external;
 mod health;
 mod inputs;
 mod motion;
@@ -19,6 +20,7 @@ mod state;
 mod static_start;
 #[cfg(test)]
 mod tests;
+mod travel;
 mod unit_state;
 mod unit_step;
 mod vehicle_state;
