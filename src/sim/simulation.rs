@@ -60,8 +60,9 @@ pub struct Simulation {
     pub(super) simd: SimdLevel,
     /// The observation points ([`Scenario::sites`]).
     pub(super) sites: Vec<Site>,
-    /// The vehicle that moves several wheelsets' wheels ([`VehicleSpec::Carrier`]: the
-    /// half-car bogie, the wagons), behind one interface.
+    /// The vehicle that moves several wheelsets' wheels
+    /// ([`VehicleSpec::Carrier`](crate::sim::VehicleSpec::Carrier): the half-car bogie,
+    /// the wagons), behind one interface.
     pub(super) carrier: Option<Box<dyn RailVehicle>>,
     /// The first two wheelsets' axle boxes under the same side frames
     /// ([`crate::sim::SideFrameSpec::HalfCar`]).

@@ -164,8 +164,8 @@ impl Simulation {
         }
     }
 
-    /// Puts the hanging sleepers ([`Scenario::voids`]) where they lie in the track as
-    /// it is now (an endless track's window moves over them).
+    /// Puts the hanging sleepers ([`Scenario::voids`](crate::sim::Scenario::voids)) where
+    /// they lie in the track as it is now (an endless track's window moves over them).
     pub(super) fn place_voids(&mut self) -> Result<()> {
         let (Some(v), TrackState::Discrete(t)) = (&self.voids, &mut self.track) else {
             if self.voids.is_some() {
