@@ -76,7 +76,9 @@ fn main() {
             let VehicleSpec::RollPlane(p) = s.vehicle else {
                 unreachable!()
             };
-            s.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(HalfCarParams::from_roll_plane(&p, 1.8, 180.0)));
+            s.vehicle = VehicleSpec::Carrier(CarrierSpec::HalfCar(HalfCarParams::from_roll_plane(
+                &p, 1.8, 180.0,
+            )));
             s.trailing = vec![TrailingWheelset {
                 offset: 1.8,
                 ..Default::default()

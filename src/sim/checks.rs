@@ -29,6 +29,15 @@ impl Scenario {
         // here: a refusal names those, the variables a user of the scenario
         // (CoupledSystem) sets.
         if let Some(c) = s.vehicle.carrier() {
+            // The count first: a vehicle on other wheelsets than its own is the first
+            // thing to set right (its offsets are checked against them).
+            if s.trailing.len() + 1 != c.wheelsets() {
+                return Err(out_of_range(
+                    "wheelsets",
+                    (s.trailing.len() + 1) as f64,
+                    format!("{} with {}", c.wheelsets(), c.name()),
+                ));
+            }
             c.validate().map_err(|e| {
                 let e = e
                     .renamed(

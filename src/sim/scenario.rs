@@ -324,8 +324,15 @@ pub enum SideFrameSpec {
     },
     /// Nothing above the axle boxes ([`SideFrameInertia::NONE`]): the suspension's
     /// upper ends go on at the velocity they came in with (the two-axle wagon's car
-    /// body).
-    Nothing,
+    /// body). Needs the vehicle's wheelsets, the second at a wheelbase in its range.
+    Nothing {
+        /// The vehicle's wheelsets.
+        wheelsets: usize,
+        /// Its wheelbase range (m): `wheelset[2].offset`'s.
+        wheelbase: (f64, f64),
+        /// Its `vehicle.model` item, for the refusals.
+        vehicle: &'static str,
+    },
 }
 
 impl SideFrameSpec {
@@ -338,7 +345,33 @@ impl SideFrameSpec {
     pub fn inertia(&self, s: &Scenario) -> crate::error::Result<(SideFrameInertia, bool)> {
         use crate::error::out_of_range;
         match *self {
-            SideFrameSpec::Nothing => Ok((SideFrameInertia::NONE, false)),
+            SideFrameSpec::Nothing {
+                wheelsets,
+                wheelbase: (lo, hi),
+                vehicle,
+            } => {
+                let n = s.trailing.len() + 1;
+                if n != wheelsets {
+                    return Err(out_of_range(
+                        "wheelsets",
+                        n as f64,
+                        format!("{wheelsets} with vehicle.model = {vehicle} at the axle boxes"),
+                    ));
+                }
+                if let Some(w) = s.trailing.first()
+                    && !(w.offset >= lo && w.offset <= hi)
+                {
+                    return Err(out_of_range(
+                        "wheelset[2].offset",
+                        w.offset,
+                        format!(
+                            "{lo} m <= wheelset[2].offset <= {hi} m (the wheelbase, with \
+                             vehicle.model = {vehicle} at the axle boxes)"
+                        ),
+                    ));
+                }
+                Ok((SideFrameInertia::NONE, false))
+            }
             SideFrameSpec::PerWheelset { mass } => {
                 crate::limits::check("vehicle.sideframe.mass", mass)?;
                 Ok((SideFrameInertia::single(mass), false))

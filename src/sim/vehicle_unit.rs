@@ -13,7 +13,7 @@
 
 use super::accelerations::Accelerations;
 use super::clock::{Clock, ForceExtremes, Stepping};
-use crate::error::{Result, finite, non_negative, num, out_of_range};
+use crate::error::{Error, Result, finite, non_negative, num, out_of_range};
 use crate::limits::{MIN_DT_FRACTION, check};
 use crate::vehicle::{
     Axles, Bodies, CONTACT_STIFFNESS, CarrierModel, CarrierSpec, ExchangeLimits, MAX_AXLES,
@@ -231,6 +231,29 @@ impl VehicleUnit {
             Body::SprungCarrier(b) => Some(b.exchange_limits(&wheels, dt, CONTACT_STIFFNESS)?),
             _ => None,
         };
+        // At rest beyond the health bounds: the suspension does not carry the vehicle
+        // (not the forces, which are the static ones here).
+        if let Err(Error::Diverged {
+            what, value, limit, ..
+        }) = unit.check_states()
+        {
+            let secondary = match p.model {
+                // The two-axle wagon has one suspension stage.
+                UnitModel::Carrier(CarrierSpec::TwoAxle(_)) => String::new(),
+                _ => format!(
+                    ", vehicle.secondary.stiffness = {} N/m",
+                    num(p.vehicle.secondary_stiffness)
+                ),
+            };
+            return Err(Error::Unsupported(format!(
+                "static equilibrium of the vehicle: at rest {what} = {} beyond {}, which no \
+                 physical run reaches: the suspension is too soft to carry the vehicle \
+                 (vehicle.primary.stiffness = {} N/m{secondary}); stiffer springs carry it",
+                num(value),
+                num(limit),
+                num(p.vehicle.primary_stiffness)
+            )));
+        }
         unit.check_states()?;
         Ok(unit)
     }

@@ -40,7 +40,7 @@ impl CarrierSpec {
 /// What TrackContact carries above a kind's axle boxes at the axle-box interface
 /// (`interface = axle_box`), moving it on over each communication step
 /// ([`super::PrimaryLink`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AboveAxleBoxes {
     /// A side frame of `vehicle.sideframe.mass` over each wheelset's axle box, in
     /// bounce (the roll-plane vehicle).
@@ -53,8 +53,12 @@ pub enum AboveAxleBoxes {
         bogies: usize,
     },
     /// Nothing: the suspension's upper ends go on at the velocity they came in with
-    /// ([`super::SideFrameInertia::NONE`]; the two-axle wagon's car body).
-    Nothing,
+    /// ([`super::SideFrameInertia::NONE`]; the two-axle wagon's car body), the wheelsets
+    /// `wheelbase` (m, least and largest) apart.
+    Nothing {
+        /// The vehicle's wheelbase range (m).
+        wheelbase: (f64, f64),
+    },
 }
 
 /// The parameter values by variable name (as the FMUs name them).
@@ -144,7 +148,9 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
         item: "two_axle",
         fmu: "TwoAxleWagon",
         wheelsets: 2,
-        above_axle_boxes: AboveAxleBoxes::Nothing,
+        above_axle_boxes: AboveAxleBoxes::Nothing {
+            wheelbase: super::two_axle::WHEELBASE_RANGE,
+        },
         offsets: &[&["wheelset[2].offset"]],
         carrier: Some(|v, offsets| {
             // The car body twice the car-body share per wheelset, the four-axle
@@ -228,6 +234,13 @@ mod tests {
                 k.item
             );
             assert_eq!(k.offsets.len(), k.wheelsets - 1, "{}", k.fmu);
+            // The wheelbase range the track checks at the axle boxes is the one the
+            // kind's FMU declares for its wheelbase.
+            if let AboveAxleBoxes::Nothing { wheelbase } = k.above_axle_boxes {
+                let vr = vars::vr_of(k.offsets[0][0]).expect("a variable");
+                let s = table.vars.iter().find(|s| s.vr == vr).expect("of the FMU");
+                assert_eq!((s.min, s.max), wheelbase, "{}", k.fmu);
+            }
             match k.own_carrier(&start) {
                 None => assert_eq!(k.wheelsets, 1),
                 Some(c) => {

@@ -12,7 +12,7 @@
 //! and primary suspension per axle box (table 4.4), the car body the wagon's
 //! ([`super::WagonParams::table_4_4`]: a uniform box 14 m long, 2.8 m wide, 2.5 m high)
 //! carrying half its load, twice the thesis' car-body share per wheelset (40.3 t), on a
-//! 9 m wheelbase: 21.4 t per axle, a loaded two-axle wagon of UIC axle-load class C.
+//! 9 m wheelbase: 21.3 t per axle, a loaded two-axle wagon of UIC axle-load class C.
 
 use super::linear_body::{LinearBody, LinearVehicle, SprungLinearBody};
 use super::rail_vehicle::{Axles, Bodies, CarrierModel, RailVehicle, SprungVehicle};

@@ -213,7 +213,11 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
                     pitch_inertia: val(vr::VEHICLE_SIDEFRAME_PITCH_INERTIA),
                     bogies,
                 },
-                AboveAxleBoxes::Nothing => SideFrameSpec::Nothing,
+                AboveAxleBoxes::Nothing { wheelbase } => SideFrameSpec::Nothing {
+                    wheelsets: model.wheelsets,
+                    wheelbase,
+                    vehicle: model.item,
+                },
             },
             static_load,
         },
