@@ -122,3 +122,42 @@ def test_the_two_axle_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent
     errors = [g / m - 1 for g, m in zip(got, ref)]
     print("two-axle wagon at the axle boxes, 1 ms, fmpy:", [f"{100 * e:+.3f} %" for e in errors])
     assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
+
+
+@pytest.mark.parametrize("params, message", [
+    ({"wheelsets": 1}, "`wheelsets` = 1 is out of range: allowed 2 with vehicle.model = two_axle at the axle boxes"),
+    ({"wheelsets": 4, "wheelset[2].offset": 9.0, "wheelset[3].offset": 12.0, "wheelset[4].offset": 21.0},
+     "`wheelsets` = 4 is out of range: allowed 2 with vehicle.model = two_axle at the axle boxes"),
+    ({"wheelsets": 2, "wheelset[2].offset": 1.8},
+     "`wheelset[2].offset` = 1.8 is out of range: allowed 4 m <= wheelset[2].offset <= 14 m"),
+])
+def test_track_contact_at_the_axle_boxes_refuses_what_the_two_axle_wagon_cannot_be(paths, params, message, capfd):
+    # The breaker's finding: TrackContact carried a two-axle wagon on one or four
+    # wheelsets, or at a bogie's wheelbase, without a word.
+    from fmpy import simulate_fmu
+    start = dict(ENDLESS, interface=2, **{"vehicle.model": wf.vehicle_kind("TwoAxleWagon")["value"]}, **params)
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        simulate_fmu(paths["TrackContact"], stop_time=0.01, start_values=start)
+    out = capfd.readouterr().out
+    assert message in out, out
+
+
+def test_coupled_system_names_the_wheelsets_before_the_offsets(paths, two_axle, capfd):
+    # Three wheelsets at CoupledSystem's default offsets: the count is what is wrong.
+    from fmpy import simulate_fmu
+    start = {"vehicle.model": two_axle["vehicle.model"], "wheelsets": 3}
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        simulate_fmu(paths["CoupledSystem"], stop_time=0.01, start_values=start)
+    out = capfd.readouterr().out
+    assert "`wheelsets` = 3 is out of range: allowed 2 with the two-axle wagon" in out, out
+
+
+def test_a_suspension_too_soft_to_carry_the_wagon_is_named(paths, capfd):
+    # At vehicle.primary.stiffness = 1e4 N/m (its declared least) the car body would
+    # rest 9.9 m down: refused at fmi2ExitInitializationMode naming the stiffness, not
+    # the forces.
+    from fmpy import simulate_fmu
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        simulate_fmu(paths["TwoAxleWagon"], stop_time=0.01, start_values={"vehicle.primary.stiffness": 1e4})
+    out = capfd.readouterr().out
+    assert "the suspension is too soft to carry the vehicle (vehicle.primary.stiffness = 10000 N/m)" in out, out
