@@ -7,9 +7,8 @@
 //!
 //! `cargo run --release --example couple_units [steps_per_exchange]`
 
-use wheelflat::sim::{
-    Scenario, Simulation, UnitModel, VehicleSpec, VehicleUnit, VehicleUnitParams,
-};
+use wheelflat::sim::{Scenario, Simulation, VehicleSpec, VehicleUnit, VehicleUnitParams};
+use wheelflat::vehicle::CarrierSpec;
 
 fn main() -> Result<(), wheelflat::Error> {
     let per_exchange: u64 = std::env::args()
@@ -29,13 +28,12 @@ fn main() -> Result<(), wheelflat::Error> {
     };
     let mut track = Simulation::new(&track_scenario)?;
     let mut car = VehicleUnit::new(&VehicleUnitParams {
-        vehicle,
         speed: scenario.speed,
         wheel_radius: scenario.wheel_radius,
         dt: 0.0,
         static_wheel_z: track.wheel_z(),
         axle_box: false,
-        model: UnitModel::RollPlane,
+        model: CarrierSpec::RollPlane(vehicle),
         trailing_static_wheel_z: [[0.0; 2]; 3],
     })?;
     let h = per_exchange as f64 * track.dt();

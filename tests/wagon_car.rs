@@ -3,17 +3,8 @@
 //! the half-car bogie on the track, the wagon as a co-simulation unit against the
 //! monolithic run, and a long run at constant memory.
 
-use wheelflat::sim::{
-    Scenario, Simulation, UnitModel, VehicleSpec, VehicleUnit, VehicleUnitParams,
-};
-use wheelflat::vehicle::{CarrierSpec, HalfCarParams, RollPlaneParams};
-
-fn roll_plane(s: &Scenario) -> RollPlaneParams {
-    match s.vehicle {
-        VehicleSpec::RollPlane(p) => p,
-        _ => unreachable!("the preset has the roll-plane vehicle"),
-    }
-}
+use wheelflat::sim::{Scenario, Simulation, VehicleSpec, VehicleUnit, VehicleUnitParams};
+use wheelflat::vehicle::{CarrierSpec, HalfCarParams};
 
 /// Table 4.4 with the wagon (1.8 m wheelbase, bogie centres 10 m apart, side frames of
 /// 180 kg m^2), the flat of the reference run on the leading wheel, 70 km/h, an
@@ -153,13 +144,12 @@ fn the_wagon_unit_with_external_wheels_at_the_tracks_step_is_the_monolithic_run(
     let mut track = Simulation::new(&ext).unwrap();
     let z = |k: usize| track.sample_of(k).unwrap().wheel_z;
     let mut unit = VehicleUnit::new(&VehicleUnitParams {
-        vehicle: roll_plane(&Scenario::table_4_4_flat()),
         speed: s.speed,
         wheel_radius: s.wheel_radius,
         dt: track.dt(),
         static_wheel_z: z(0),
         axle_box: false,
-        model: UnitModel::Carrier(CarrierSpec::Wagon(w)),
+        model: CarrierSpec::Wagon(w),
         trailing_static_wheel_z: [z(1), z(2), z(3)],
     })
     .unwrap();

@@ -38,5 +38,5 @@ pub use scenario::{
 pub use simulation::{Simulation, TrackState};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};
 pub use vehicle_state::VehicleState;
-pub use vehicle_unit::{UnitModel, VehicleUnit, VehicleUnitParams};
+pub use vehicle_unit::{VehicleUnit, VehicleUnitParams};
 pub use wheelset::{Sample, Wheelset, Wheelsets};

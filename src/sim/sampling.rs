@@ -5,6 +5,7 @@
 use super::simulation::{Simulation, TrackState, at_level};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Sample, Wheelset, contact_states};
+use crate::vehicle::RailVehicle;
 
 impl Simulation {
     /// Forgets the cached samples: the time or the inputs changed.
@@ -33,6 +34,19 @@ impl Simulation {
         match w.vehicle.wheel_z() {
             Some(z) => z,
             None => self.rail_z_under(w.position(self.position()) - self.origin),
+        }
+    }
+
+    /// The vehicle that moves wheelset `k`'s wheels, with the wheelset's index among
+    /// its own: the vehicle on several wheelsets ([`Simulation::carrier`]), or the
+    /// wheelset's own roll-plane vehicle; `None` for loads, lumped or external wheels,
+    /// the wheelsets the axle-box interface carries and a wheelset the simulation does
+    /// not have.
+    pub fn vehicle_of(&self, k: usize) -> Option<(&dyn RailVehicle, usize)> {
+        match &self.wheelsets.get(k)?.vehicle {
+            VehicleState::RollPlane(v) => Some((v, 0)),
+            VehicleState::OnBogie { axle } => self.carrier.as_deref().map(|b| (b, *axle)),
+            _ => None,
         }
     }
 

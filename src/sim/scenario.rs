@@ -65,6 +65,15 @@ pub enum VehicleSpec {
 }
 
 impl VehicleSpec {
+    /// The vehicle of the registry's kind `spec`: the roll-plane vehicle rides on each
+    /// wheelset, its own on each; any other kind is one vehicle over its wheelsets.
+    pub fn of_kind(spec: CarrierSpec) -> VehicleSpec {
+        match spec {
+            CarrierSpec::RollPlane(p) => VehicleSpec::RollPlane(p),
+            c => VehicleSpec::Carrier(c),
+        }
+    }
+
     /// The vehicle on several wheelsets, behind its interface; `None` for a vehicle or
     /// load on each wheelset.
     pub fn carrier(&self) -> Option<&dyn crate::vehicle::CarrierModel> {

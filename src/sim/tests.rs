@@ -4,7 +4,7 @@
 use super::clock::{Clock, ForceExtremes, Stepping};
 use super::*;
 use crate::limits::MIN_STEP_FRACTION;
-use crate::vehicle::RollPlaneParams;
+use crate::vehicle::{CarrierSpec, RollPlaneParams};
 
 /// Couples an external-wheel track simulation with a vehicle unit, as two FMUs
 /// would be coupled, and returns the contact forces per step.
@@ -19,12 +19,11 @@ fn run_pair(s: &Scenario, h_per_dt: u64, steps: usize) -> Vec<[f64; 2]> {
     };
     let mut track = Simulation::new(&ts).unwrap();
     let mut veh = VehicleUnit::new(&VehicleUnitParams {
-        vehicle: vp,
         speed: s.speed,
         wheel_radius: s.wheel_radius,
         dt: 0.0,
         axle_box: false,
-        model: UnitModel::RollPlane,
+        model: CarrierSpec::RollPlane(vp),
         trailing_static_wheel_z: [[0.0; 2]; 3],
         static_wheel_z: track.wheel_z(),
     })
@@ -77,13 +76,12 @@ fn table_4_4_unit(
         unreachable!()
     };
     VehicleUnitParams {
-        vehicle: vp,
         speed: 20.0,
         wheel_radius: 0.475,
         dt: dt(&vp),
         static_wheel_z,
         axle_box: false,
-        model: UnitModel::RollPlane,
+        model: CarrierSpec::RollPlane(vp),
         trailing_static_wheel_z: [[0.0; 2]; 3],
     }
 }
@@ -124,7 +122,7 @@ fn any_sequence_of_communication_steps_stays_stable_and_close_to_fixed_steps() {
     // at almost every call. The wheels rest on linear springs fed back by the
     // master (a stand-in track) and get a 10 ms push of half the static load.
     let p = table_4_4_unit(|vp| 0.5 * vp.critical_time_step(), [-1.4e-3, -1.4e-3]);
-    let w = p.vehicle.static_wheel_load();
+    let w = p.model.model().static_wheel_load();
     let forces = |u: &VehicleUnit, t: f64| {
         let (z, k) = (u.wheel_z(), 2e7);
         let push = if t < 0.01 { 0.5 * w } else { 0.0 };

@@ -12,10 +12,8 @@ impl VehicleUnit {
     /// The body's state vector.
     pub(super) fn body_state(&self) -> Vec<f64> {
         match &self.body {
-            Body::RollPlane(v) => v.state_vector(),
-            Body::Sprung { bogie, .. } => bogie.state_vector(),
-            Body::Carrier(b) => b.state_vector(),
-            Body::SprungCarrier(b) => b.state_vector(),
+            Body::Whole(b) => b.state_vector(),
+            Body::Sprung(b) => b.state_vector(),
         }
     }
 
@@ -106,10 +104,8 @@ impl VehicleUnit {
         }
         let body = &v[head..];
         match &mut self.body {
-            Body::RollPlane(v) => v.set_state_vector(body)?,
-            Body::Sprung { bogie, .. } => bogie.set_state_vector(body)?,
-            Body::Carrier(b) => b.set_state_vector(body)?,
-            Body::SprungCarrier(b) => b.set_state_vector(body)?,
+            Body::Whole(b) => b.set_state_vector(body)?,
+            Body::Sprung(b) => b.set_state_vector(body)?,
         }
         self.clock.dt = dt;
         self.clock.t0 = v[0];
@@ -183,10 +179,8 @@ impl VehicleUnit {
     /// Checks the bodies and the wheels against the health bounds of [`crate::limits`].
     pub fn check_states(&self) -> Result<()> {
         let bad = match &self.body {
-            Body::RollPlane(v) => v.beyond_bounds(),
-            Body::Sprung { bogie, .. } => bogie.beyond_bounds(),
-            Body::Carrier(b) => b.beyond_bounds(),
-            Body::SprungCarrier(b) => b.beyond_bounds(),
+            Body::Whole(b) => b.beyond_bounds(),
+            Body::Sprung(b) => b.beyond_bounds(),
         };
         match bad {
             None => Ok(()),

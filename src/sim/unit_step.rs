@@ -41,10 +41,8 @@ impl VehicleUnit {
         self.clock.carried = 0.0;
         if let Some(dt) = s.dt {
             match &mut self.body {
-                Body::RollPlane(v) => v.change_dt(dt)?,
-                Body::Sprung { bogie, .. } => bogie.change_dt(dt)?,
-                Body::Carrier(b) => b.change_dt(dt)?,
-                Body::SprungCarrier(b) => b.change_dt(dt)?,
+                Body::Whole(b) => b.change_dt(dt)?,
+                Body::Sprung(b) => b.change_dt(dt)?,
             }
             self.clock.restart(dt);
         }
@@ -54,21 +52,15 @@ impl VehicleUnit {
         let n = s.n as u64;
         let dt = self.clock.dt;
         match &mut self.body {
-            Body::RollPlane(v) => (0..n).for_each(|_| {
+            Body::Whole(b) => (0..n).for_each(|_| {
                 // The wheels at the start of each step, as the engine samples them.
-                let z = v.wheel_z();
-                self.accelerations[0].record([z[0], z[1], 0.0, 0.0], dt);
-                v.step(self.force[0])
-            }),
-            Body::Sprung { bogie, .. } => (0..n).for_each(|_| bogie.step(self.force[0])),
-            Body::Carrier(b) => (0..n).for_each(|_| {
                 let w = b.wheelsets();
                 for (a, z) in self.accelerations.iter_mut().zip(b.wheel_z()).take(w) {
                     a.record([z[0], z[1], 0.0, 0.0], dt);
                 }
                 b.step(&self.force)
             }),
-            Body::SprungCarrier(b) => (0..n).for_each(|_| b.step(&self.force)),
+            Body::Sprung(b) => (0..n).for_each(|_| b.step(&self.force)),
         }
         for _ in 0..n {
             self.clock.tick();

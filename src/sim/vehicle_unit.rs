@@ -16,35 +16,32 @@ use super::clock::{Clock, ForceExtremes, Stepping};
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range};
 use crate::limits::{MIN_DT_FRACTION, check};
 use crate::vehicle::{
-    Axles, Bodies, CONTACT_STIFFNESS, CarrierModel, CarrierSpec, ExchangeLimits, MAX_AXLES,
-    RailVehicle, RollPlaneParams, RollPlaneVehicle, SprungBogie, SprungVehicle,
+    Axles, Bodies, CONTACT_STIFFNESS, CarrierSpec, ExchangeLimits, MAX_AXLES, RailVehicle,
+    SprungVehicle,
 };
-use nalgebra::Vector6;
 
 /// Parameters of a [`VehicleUnit`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VehicleUnitParams {
-    /// The roll-plane vehicle.
-    pub vehicle: RollPlaneParams,
+    /// The vehicle, any kind of the registry ([`crate::vehicle::VEHICLE_KINDS`]): the
+    /// roll-plane vehicle on one wheelset, the half-car bogie, the wagons.
+    pub model: CarrierSpec,
     /// Forward speed `V` (m/s): turns the axle at `V / R_w`.
     pub speed: f64,
     /// Nominal wheel radius `R_w` (m).
     pub wheel_radius: f64,
-    /// Base step (s); 0 takes [`RollPlaneParams::default_dt`].
+    /// Base step (s); 0 takes the vehicle's [`CarrierModel::default_dt`].
     pub dt: f64,
     /// Wheel-centre displacements `[left, right]` (m) of the static equilibrium, as the
     /// track computed them: the vehicle starts at rest on them.
     pub static_wheel_z: [f64; 2],
     /// The axle-box interface: the unit is the vehicle above its primary suspension
-    /// ([`crate::vehicle::SprungBogie::new`]), the primary forces come in
+    /// ([`CarrierModel::sprung`]), the primary forces come in
     /// (held over each communication step) and the side frames' motion goes out; its
     /// partner carries the wheelset and the primary suspension
     /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
     /// contact forces in.
     pub axle_box: bool,
-    /// The vehicle on several wheelsets instead of the roll-plane vehicle on one: the
-    /// half-car bogie or the wagon.
-    pub model: UnitModel,
     /// The static wheel-centre displacements `[left, right]` (m) of the wheelsets
     /// behind the leading one, for a vehicle on several wheelsets.
     pub trailing_static_wheel_z: [[f64; 2]; MAX_AXLES - 1],
@@ -59,49 +56,15 @@ impl VehicleUnitParams {
     }
 }
 
-/// Which vehicle a [`VehicleUnit`] is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum UnitModel {
-    /// The roll-plane vehicle ([`VehicleUnitParams::vehicle`]) on one wheelset.
-    RollPlane,
-    /// A vehicle on several wheelsets, any kind of the registry
-    /// ([`crate::vehicle::VEHICLE_KINDS`]).
-    Carrier(CarrierSpec),
-}
-
-impl UnitModel {
-    /// The vehicle on several wheelsets, behind its interface; `None` for the
-    /// roll-plane vehicle.
-    pub fn carrier(&self) -> Option<&dyn CarrierModel> {
-        match self {
-            UnitModel::RollPlane => None,
-            UnitModel::Carrier(c) => Some(c.model()),
-        }
-    }
-
-    /// Number of wheelsets.
-    pub fn wheelsets(&self) -> usize {
-        self.carrier().map_or(1, |c| c.wheelsets())
-    }
-}
-
-/// What a [`VehicleUnit`] steps.
+/// What a [`VehicleUnit`] steps: the whole vehicle under the contact forces of its
+/// wheels, or the vehicle above its primary suspension under the primary forces at its
+/// axle boxes (its partner carries the wheelsets).
 #[derive(Debug, Clone)]
 pub(super) enum Body {
-    /// The roll-plane vehicle, the contact forces in.
-    RollPlane(Box<RollPlaneVehicle>),
-    /// The roll-plane vehicle above its primary suspension, the primary forces in;
-    /// `rest`, the whole vehicle at rest on the static wheel heights, gives the
-    /// wheelset's outputs (the partner carries the wheelset).
-    Sprung {
-        bogie: Box<SprungBogie>,
-        rest: Box<RollPlaneVehicle>,
-    },
-    /// A vehicle on several wheelsets, the contact forces of its wheels in.
-    Carrier(Box<dyn RailVehicle>),
-    /// A vehicle on several wheelsets above its primary suspension, the primary forces
-    /// at its axle boxes in.
-    SprungCarrier(Box<dyn SprungVehicle>),
+    /// The whole vehicle, the contact forces in.
+    Whole(Box<dyn RailVehicle>),
+    /// The vehicle above its primary suspension, the primary forces in.
+    Sprung(Box<dyn SprungVehicle>),
 }
 
 /// A vehicle as a co-simulation unit: the six-DOF roll-plane vehicle (3.1-3.3,
@@ -150,22 +113,14 @@ impl VehicleUnit {
         non_negative("solver.dt", p.dt, "s")?;
         check("static_wheel_z.left", p.static_wheel_z[0])?;
         check("static_wheel_z.right", p.static_wheel_z[1])?;
-        // A vehicle on several wheelsets checks its own parameters below.
-        if p.model.carrier().is_none() {
-            p.vehicle.validate()?;
-        }
-        let n = p.model.wheelsets();
+        let c = p.model.model();
+        c.validate()?;
+        let n = c.wheelsets();
         for (z, k) in p.trailing_static_wheel_z.iter().take(n - 1).zip(2..) {
             check(&format!("wheelset[{k}].static_wheel_z.left"), z[0])?;
             check(&format!("wheelset[{k}].static_wheel_z.right"), z[1])?;
         }
-        let (critical, default_dt) = match p.model.carrier() {
-            None => (p.vehicle.critical_time_step(), p.vehicle.default_dt()),
-            Some(c) => {
-                c.validate()?;
-                (c.critical_time_step(), c.default_dt())
-            }
-        };
+        let (critical, default_dt) = (c.critical_time_step(), c.default_dt());
         let dt = if p.dt == 0.0 { default_dt } else { p.dt };
         if !(dt >= MIN_DT_FRACTION * critical && dt <= 0.5 * critical) {
             return Err(out_of_range(
@@ -182,35 +137,16 @@ impl VehicleUnit {
                 ),
             ));
         }
-        let roll_plane_at_rest = || -> Result<Box<RollPlaneVehicle>> {
-            let mut v = RollPlaneVehicle::new(p.vehicle, dt)?;
-            v.set_static(p.static_wheel_z)?;
-            Ok(Box::new(v))
-        };
         let wheels = p.static_wheels();
-        let mut force = [[p.vehicle.static_wheel_load(); 2]; MAX_AXLES];
-        let body = match (p.model.carrier(), p.axle_box) {
-            (Some(c), false) => {
-                let mut b = c.whole(dt)?;
-                force = b.set_static(&wheels)?;
-                Body::Carrier(b)
-            }
-            (Some(c), true) => {
-                let mut b = c.sprung(dt)?;
-                force = b.set_static(&wheels)?;
-                Body::SprungCarrier(b)
-            }
-            (None, false) => Body::RollPlane(roll_plane_at_rest()?),
-            (None, true) => {
-                let mut b = SprungBogie::new(p.vehicle, dt)?;
-                b.set_static(p.static_wheel_z)?;
-                let rest = roll_plane_at_rest()?;
-                force[0] = rest.bearing_forces();
-                Body::Sprung {
-                    bogie: Box::new(b),
-                    rest,
-                }
-            }
+        // At rest on the static wheels: the forces that hold it there.
+        let (body, force) = if p.axle_box {
+            let mut b = c.sprung(dt)?;
+            let force = b.set_static(&wheels)?;
+            (Body::Sprung(b), force)
+        } else {
+            let mut b = c.whole(dt)?;
+            let force = b.set_static(&wheels)?;
+            (Body::Whole(b), force)
         };
         let mut unit = VehicleUnit {
             params: *p,
@@ -225,11 +161,8 @@ impl VehicleUnit {
             exchange: None,
         };
         unit.exchange = match &unit.body {
-            Body::Sprung { bogie, .. } => {
-                Some(bogie.exchange_limits(p.static_wheel_z, dt, CONTACT_STIFFNESS)?)
-            }
-            Body::SprungCarrier(b) => Some(b.exchange_limits(&wheels, dt, CONTACT_STIFFNESS)?),
-            _ => None,
+            Body::Sprung(b) => Some(b.exchange_limits(&wheels, dt, CONTACT_STIFFNESS)?),
+            Body::Whole(_) => None,
         };
         // At rest beyond the health bounds: the suspension does not carry the vehicle
         // (not the forces, which are the static ones here).
@@ -237,21 +170,18 @@ impl VehicleUnit {
             what, value, limit, ..
         }) = unit.check_states()
         {
-            let secondary = match p.model {
-                // The two-axle wagon has one suspension stage.
-                UnitModel::Carrier(CarrierSpec::TwoAxle(_)) => String::new(),
-                _ => format!(
-                    ", vehicle.secondary.stiffness = {} N/m",
-                    num(p.vehicle.secondary_stiffness)
-                ),
-            };
+            let stiffnesses = c
+                .stiffnesses()
+                .iter()
+                .map(|(name, k)| format!("{name} = {} N/m", num(*k)))
+                .collect::<Vec<_>>()
+                .join(", ");
             return Err(Error::Unsupported(format!(
                 "static equilibrium of the vehicle: at rest {what} = {} beyond {}, which no \
                  physical run reaches: the suspension is too soft to carry the vehicle \
-                 (vehicle.primary.stiffness = {} N/m{secondary}); stiffer springs carry it",
+                 ({stiffnesses}); stiffer springs carry it",
                 num(value),
                 num(limit),
-                num(p.vehicle.primary_stiffness)
             )));
         }
         unit.check_states()?;
@@ -262,18 +192,14 @@ impl VehicleUnit {
     pub fn params(&self) -> &VehicleUnitParams {
         &self.params
     }
-    /// Number of wheelsets: 1 for the roll-plane vehicle, 2 for the half-car bogie, 4
-    /// for the wagon.
+    /// Number of wheelsets: 1 for the roll-plane vehicle, 2 for the half-car bogie and
+    /// the two-axle wagon, 4 for the four-axle wagon.
     pub fn wheelsets(&self) -> usize {
-        self.params.model.wheelsets()
+        self.params.model.model().wheelsets()
     }
     /// Static load on each wheel `[left, right]` (N).
     pub fn static_load(&self) -> [f64; 2] {
-        let w = match self.params.model.carrier() {
-            Some(c) => c.static_wheel_load(),
-            None => self.params.vehicle.static_wheel_load(),
-        };
-        [w, w]
+        [self.params.model.model().static_wheel_load(); 2]
     }
     /// Base step (s).
     pub fn dt_base(&self) -> f64 {
@@ -286,9 +212,8 @@ impl VehicleUnit {
     /// Critical step of the vehicle's explicit scheme (s).
     pub fn critical_step(&self) -> f64 {
         match &self.body {
-            Body::RollPlane(_) | Body::Sprung { .. } => self.params.vehicle.critical_time_step(),
-            Body::Carrier(b) => b.critical_time_step(),
-            Body::SprungCarrier(b) => b.critical_time_step(),
+            Body::Whole(b) => b.critical_time_step(),
+            Body::Sprung(b) => b.critical_time_step(),
         }
     }
     /// Time (s).
@@ -338,9 +263,8 @@ impl VehicleUnit {
             return None;
         }
         Some(match &self.body {
-            Body::RollPlane(v) | Body::Sprung { rest: v, .. } => v.wheel_z(),
-            Body::Carrier(b) => b.wheel_z()[k],
-            Body::SprungCarrier(_) => self.params.static_wheels()[k],
+            Body::Whole(b) => b.wheel_z()[k],
+            Body::Sprung(_) => self.params.static_wheels()[k],
         })
     }
     /// Wheel-centre velocities `[left, right]` (m/s) of wheelset `k`, backward
@@ -351,39 +275,17 @@ impl VehicleUnit {
         if k >= self.wheelsets() {
             return None;
         }
-        let h = 0.5 * self.params.vehicle.primary_spacing;
         Some(match &self.body {
-            Body::RollPlane(v) => {
-                let v = v.velocities();
-                [v[4] - h * v[5], v[4] + h * v[5]]
-            }
-            Body::Carrier(b) => b.wheel_velocities()[k],
-            Body::Sprung { .. } | Body::SprungCarrier(_) => [0.0; 2],
+            Body::Whole(b) => b.wheel_velocities()[k],
+            Body::Sprung(_) => [0.0; 2],
         })
     }
-    /// Displacements `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` (m, rad) of the
-    /// roll-plane vehicle; with the axle-box interface the wheelset's are its static
-    /// ones (the partner carries it). Zero for a vehicle on several wheelsets
-    /// ([`VehicleUnit::bodies`]).
-    pub fn displacements(&self) -> Vector6<f64> {
+    /// The bodies' motion (m, rad); with the axle-box interface the wheelsets' are
+    /// their static ones (the partner carries them).
+    pub fn bodies(&self) -> Bodies {
         match &self.body {
-            Body::RollPlane(v) => *v.displacements(),
-            Body::Sprung { bogie, rest } => {
-                let mut d = *rest.displacements();
-                d.fixed_rows_mut::<4>(0).copy_from(bogie.displacements());
-                d
-            }
-            Body::Carrier(_) | Body::SprungCarrier(_) => Vector6::zeros(),
-        }
-    }
-    /// The bodies of a vehicle on several wheelsets (m, rad); with the axle-box
-    /// interface the wheelsets' are their static ones. `None` for the roll-plane
-    /// vehicle.
-    pub fn bodies(&self) -> Option<Bodies> {
-        match &self.body {
-            Body::Carrier(b) => Some(b.bodies()),
-            Body::SprungCarrier(b) => Some(b.bodies()),
-            _ => None,
+            Body::Whole(b) => b.bodies(),
+            Body::Sprung(b) => b.bodies(),
         }
     }
     /// Primary suspension (bearing) forces `[left, right]` (N) of the leading
@@ -398,9 +300,8 @@ impl VehicleUnit {
             return None;
         }
         Some(match &self.body {
-            Body::RollPlane(v) => v.bearing_forces(),
-            Body::Sprung { .. } | Body::SprungCarrier(_) => self.force[k],
-            Body::Carrier(b) => b.bearing_forces()[k],
+            Body::Whole(b) => b.bearing_forces()[k],
+            Body::Sprung(_) => self.force[k],
         })
     }
     /// The side frames' displacements and velocities `[left, right]` (m, m/s) at the
@@ -415,27 +316,17 @@ impl VehicleUnit {
         if k >= self.wheelsets() {
             return None;
         }
-        Some(match &self.body {
-            Body::Sprung { bogie, .. } => bogie.side_frames(),
-            Body::RollPlane(r) => {
-                let (d, v) = (r.displacements(), r.velocities());
-                ([d[2], d[3]], [v[2], v[3]])
-            }
-            Body::Carrier(b) => {
-                let (z, v) = b.side_frames();
-                (z[k], v[k])
-            }
-            Body::SprungCarrier(b) => {
-                let (z, v) = b.side_frames();
-                (z[k], v[k])
-            }
-        })
+        let (z, v) = match &self.body {
+            Body::Whole(b) => b.side_frames(),
+            Body::Sprung(b) => b.side_frames(),
+        };
+        Some((z[k], v[k]))
     }
     /// With the axle-box interface, the largest communication steps (s) at which the
     /// explicit exchange of the primary forces stays stable under a sequential and a
     /// Jacobi master, estimated from the spectral radius of the exchange's
     /// amplification matrix with every term that crosses the cut, springs and dampers
-    /// ([`crate::vehicle::SprungBogie::exchange_limits`]; measured on the track within
+    /// ([`SprungVehicle::exchange_limits`]; measured on the track within
     /// 0.7 to 1 times the measured limits, `examples/axle_box_masters.rs`). `None`
     /// without the axle-box interface.
     pub fn exchange_limits(&self) -> Option<ExchangeLimits> {
@@ -444,7 +335,7 @@ impl VehicleUnit {
 
     /// Whether the unit is the vehicle above its primary suspension.
     pub fn is_axle_box(&self) -> bool {
-        matches!(self.body, Body::Sprung { .. } | Body::SprungCarrier(_))
+        matches!(self.body, Body::Sprung(_))
     }
     /// The forces `[left, right]` (N) of wheelset `k` that hold the vehicle at rest
     /// (contact, or primary with the axle-box interface); `None` for a wheelset the

@@ -20,7 +20,7 @@
 use super::MAX_AXLES;
 use super::linear_body::{LinearVehicle, SprungLinearBody};
 use super::rail_vehicle::{Axles, SprungVehicle};
-use super::{PrimaryLink, RollPlaneParams, SideFrameInertia, SprungBogie};
+use super::{PrimaryLink, RollPlaneParams, SideFrameInertia};
 use crate::error::Result;
 use nalgebra::DMatrix;
 
@@ -44,30 +44,6 @@ trait SprungBody: Clone {
     fn set_state(&mut self, v: &[f64]);
     /// Changes the substep to `dt` (s), below the bogie's critical step.
     fn set_step(&mut self, dt: f64);
-}
-
-impl SprungBody for SprungBogie {
-    fn boxes(&self) -> usize {
-        2
-    }
-    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
-        let (z, v) = self.side_frames();
-        (z.to_vec(), v.to_vec())
-    }
-    fn step_boxes(&mut self, f: &[f64]) {
-        self.step([f[0], f[1]]);
-    }
-    fn state(&self) -> Vec<f64> {
-        self.state_vector()
-    }
-    fn set_state(&mut self, v: &[f64]) {
-        // The same step and displacements of the same length: always accepted.
-        let _ = self.set_state_vector(v);
-    }
-    fn set_step(&mut self, dt: f64) {
-        // At most the base step, which the bogie accepted.
-        let _ = self.change_dt(dt);
-    }
 }
 
 /// The largest stable communication steps (s) of the axle-box exchange, estimated as
@@ -341,22 +317,3 @@ const SUPPORT_DAMPING: f64 = 1e5;
 /// Contact stiffness per wheel (N/m) the estimates take by default: the adaptive
 /// contact's at the static load of table 4.4, about 1.45e9 N/m.
 pub const CONTACT_STIFFNESS: f64 = 1.45e9;
-
-impl SprungBogie {
-    /// [`ExchangeLimits`] of this bogie at rest with its axle boxes at `z_box` (m), its
-    /// substeps at most `base` (s), its wheelset on contact springs of `support` (N/m
-    /// per wheel, [`CONTACT_STIFFNESS`]), side frames of its own mass.
-    ///
-    /// Errors: a parameter [`PrimaryLink::new`] refuses.
-    pub fn exchange_limits(
-        &self,
-        z_box: [f64; 2],
-        base: f64,
-        support: f64,
-    ) -> Result<ExchangeLimits> {
-        let p = *self.params();
-        let inertia = SideFrameInertia::single(p.sideframe_mass);
-        let track = track_side(self, &p, inertia, &z_box, support)?;
-        Ok(limits_of(self, &track, base))
-    }
-}

@@ -208,6 +208,12 @@ impl CarrierModel for HalfCarParams {
     fn static_wheel_load(&self) -> f64 {
         HalfCarParams::static_wheel_load(self)
     }
+    fn stiffnesses(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("vehicle.primary.stiffness", self.primary_stiffness),
+            ("vehicle.secondary.stiffness", self.secondary_stiffness),
+        ]
+    }
     fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
         Ok(Box::new(HalfCarBogie::new(*self, dt)?))
     }

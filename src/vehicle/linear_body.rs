@@ -77,6 +77,31 @@ pub trait LinearVehicle<const N: usize, const S: usize>:
         support: f64,
     ) -> Result<ExchangeLimits>;
 
+    /// The force's share of a step, `P_f (F_gravity + F_contact(p))` (`P_f` the
+    /// update's `dt^2 [I + dt/2 M^-1 C]^-1 M^-1`), `constant` the part that stays the
+    /// same from step to step ([`LinearVehicle::step_constant`]). By default the
+    /// product in full; a vehicle whose contact forces act on a few degrees of freedom
+    /// forms it from those columns of `P_f` (the roll-plane vehicle: its wheelset's).
+    #[inline(always)]
+    fn force_share(
+        &self,
+        p_force: &SMatrix<f64, N, N>,
+        gravity: &SVector<f64, N>,
+        _constant: &SVector<f64, N>,
+        p: &Axles,
+    ) -> SVector<f64, N> {
+        p_force * (gravity + self.contact_force(p))
+    }
+    /// The part of [`LinearVehicle::force_share`] that stays the same from step to step
+    /// for the update's `p_force` and the gravity `gravity` (zero by default, unused).
+    fn step_constant(
+        &self,
+        _p_force: &SMatrix<f64, N, N>,
+        _gravity: &SVector<f64, N>,
+    ) -> SVector<f64, N> {
+        SVector::zeros()
+    }
+
     /// Undamped natural frequencies (rad/s), ascending: the square roots of the
     /// eigenvalues of `M^-1 K`.
     fn natural_frequencies(&self) -> [f64; N] {
@@ -166,6 +191,8 @@ pub struct LinearBody<P: LinearVehicle<N, S>, const N: usize, const S: usize> {
     params: P,
     cd: CentralDifference<N>,
     gravity: SVector<f64, N>,
+    /// [`LinearVehicle::step_constant`] for the step in use.
+    constant: SVector<f64, N>,
 }
 
 impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> LinearBody<P, N, S> {
@@ -177,7 +204,7 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> LinearBody<P, N, S>
         params.validate()?;
         positive("solver.dt", dt, "s")?;
         params.check_time_step(dt)?;
-        Ok(LinearBody {
+        let mut body = LinearBody {
             params,
             cd: CentralDifference::new(
                 &params.mass_diagonal(),
@@ -186,7 +213,15 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> LinearBody<P, N, S>
                 dt,
             ),
             gravity: params.gravity_force(),
-        })
+            constant: SVector::zeros(),
+        };
+        body.set_constant();
+        Ok(body)
+    }
+
+    /// [`LinearVehicle::step_constant`] for the step in use.
+    fn set_constant(&mut self) {
+        self.constant = self.params.step_constant(self.cd.p_force(), &self.gravity);
     }
 
     /// Parameters.
@@ -197,9 +232,17 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> LinearBody<P, N, S>
     pub fn displacements(&self) -> &SVector<f64, N> {
         self.cd.d()
     }
+    /// Displacements at `t_(j-1)` (m, rad).
+    pub fn previous_displacements(&self) -> &SVector<f64, N> {
+        self.cd.d_prev()
+    }
     /// Velocities at `t_j`, backward differences over the last step (m/s, rad/s).
     pub fn velocities(&self) -> SVector<f64, N> {
         self.cd.velocities()
+    }
+    /// Sets the displacements at `t_j` and `t_(j-1)` (m, rad).
+    pub fn set_state(&mut self, d: SVector<f64, N>, d_prev: SVector<f64, N>) {
+        self.cd.set_state(d, d_prev);
     }
 }
 
@@ -237,9 +280,12 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> RailVehicle for Lin
     fn bodies(&self) -> Bodies {
         self.params.bodies(self.cd.d().as_slice())
     }
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, p: &Axles) {
-        self.cd.advance(self.gravity + self.params.contact_force(p));
+        let pf = self
+            .params
+            .force_share(self.cd.p_force(), &self.gravity, &self.constant, p);
+        self.cd.advance_premultiplied(pf);
     }
     fn set_static(&mut self, z: &Axles) -> Result<Axles> {
         let d = self
@@ -251,7 +297,9 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> RailVehicle for Lin
     }
     fn change_dt(&mut self, dt: f64) -> Result<()> {
         let p = self.params;
-        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))
+        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))?;
+        self.set_constant();
+        Ok(())
     }
     fn state_vector(&self) -> Vec<f64> {
         self.cd.state_vector()
@@ -259,7 +307,9 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> RailVehicle for Lin
     fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
         let p = self.params;
         let what = format!("{} state length", P::WHAT);
-        self.cd.restore(v, &what, |h| p.check_time_step(h))
+        self.cd.restore(v, &what, |h| p.check_time_step(h))?;
+        self.set_constant();
+        Ok(())
     }
     fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
         bodies_beyond(&self.cd, |i| P::DOF_NAMES[i])

@@ -31,7 +31,6 @@ mod lumped;
 mod rail_vehicle;
 mod registry;
 mod roll_plane;
-mod sprung_bogie;
 #[cfg(test)]
 mod tests;
 mod two_axle;
@@ -53,8 +52,7 @@ pub use registry::{
     AboveAxleBoxes, CarrierSpec, VEHICLE_KINDS, Values, VehicleKind, kind_of_fmu, kind_of_item,
     roll_plane,
 };
-pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle};
-pub use sprung_bogie::SprungBogie;
+pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle, SprungBogie};
 pub use two_axle::{SprungTwoAxleWagon, TWO_AXLE_DOFS, TwoAxleParams, TwoAxleWagon};
 pub use wagon::{MIN_BOGIE_GAP, WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
 pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};

@@ -58,6 +58,9 @@ pub trait CarrierModel {
     fn default_dt(&self) -> f64;
     /// Static load on each wheel (N).
     fn static_wheel_load(&self) -> f64;
+    /// The suspension's stiffnesses, each by its variable's name (N/m), for the
+    /// refusal of a suspension too soft to carry the vehicle.
+    fn stiffnesses(&self) -> Vec<(&'static str, f64)>;
     /// The whole vehicle at rest at zero, stepped with `dt` (s).
     ///
     /// Errors: a parameter refused, `dt` not positive or above the critical step.

@@ -18,6 +18,8 @@ use super::{HalfCarParams, RollPlaneParams, TwoAxleParams, WagonParams};
 /// The parameters of a vehicle on several wheelsets, of any kind the registry lists.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CarrierSpec {
+    /// The roll-plane vehicle ([`RollPlaneParams`]), on one wheelset.
+    RollPlane(RollPlaneParams),
     /// The half-car bogie ([`HalfCarParams`]).
     HalfCar(HalfCarParams),
     /// The four-axle wagon ([`WagonParams`]).
@@ -30,6 +32,7 @@ impl CarrierSpec {
     /// The vehicle behind its interface.
     pub fn model(&self) -> &dyn CarrierModel {
         match self {
+            CarrierSpec::RollPlane(p) => p,
             CarrierSpec::HalfCar(p) => p,
             CarrierSpec::Wagon(p) => p,
             CarrierSpec::TwoAxle(p) => p,
@@ -81,9 +84,8 @@ pub struct VehicleKind {
     pub offsets: &'static [&'static [&'static str]],
     /// Its parameters from the variables, its wheelsets behind the leading one at
     /// `offsets` (m): CoupledSystem's `wheelset[k].offset`, or in its own FMU those of
-    /// [`VehicleKind::offsets`]. `None` for the roll-plane vehicle, which rides on each
-    /// wheelset by itself.
-    pub carrier: Option<fn(Values, &[f64]) -> CarrierSpec>,
+    /// [`VehicleKind::offsets`].
+    pub carrier: fn(Values, &[f64]) -> CarrierSpec,
 }
 
 impl VehicleKind {
@@ -96,10 +98,9 @@ impl VehicleKind {
             .collect()
     }
 
-    /// The vehicle its own FMU's parameters `v` describe; `None` for the roll-plane
-    /// vehicle.
-    pub fn own_carrier(&self, v: Values) -> Option<CarrierSpec> {
-        self.carrier.map(|build| build(v, &self.own_offsets(v)))
+    /// The vehicle its own FMU's parameters `v` describe.
+    pub fn own_carrier(&self, v: Values) -> CarrierSpec {
+        (self.carrier)(v, &self.own_offsets(v))
     }
 }
 
@@ -111,7 +112,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
         wheelsets: 1,
         above_axle_boxes: AboveAxleBoxes::SideFramePerWheelset,
         offsets: &[],
-        carrier: None,
+        carrier: |v, _| CarrierSpec::RollPlane(roll_plane(v)),
     },
     VehicleKind {
         item: "half_car",
@@ -119,7 +120,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
         wheelsets: 2,
         above_axle_boxes: AboveAxleBoxes::BogieSideFrames { bogies: 1 },
         offsets: &[&["vehicle.wheelbase"]],
-        carrier: Some(|v, offsets| CarrierSpec::HalfCar(half_car(v, offsets[0]))),
+        carrier: |v, offsets| CarrierSpec::HalfCar(half_car(v, offsets[0])),
     },
     VehicleKind {
         item: "wagon",
@@ -133,7 +134,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
         ],
         // The wheelbase and the bogie distance are the offsets of wheelsets 2 and 3
         // (the engine checks the fourth).
-        carrier: Some(|v, offsets| {
+        carrier: |v, offsets| {
             let (a, d) = (offsets[0], offsets[1]);
             CarrierSpec::Wagon(WagonParams {
                 carbody_mass: 4.0 * v("vehicle.carbody_mass"),
@@ -142,7 +143,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
                 bogie_distance: d,
                 bogie: half_car(v, a),
             })
-        }),
+        },
     },
     VehicleKind {
         item: "two_axle",
@@ -152,7 +153,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
             wheelbase: super::two_axle::WHEELBASE_RANGE,
         },
         offsets: &[&["wheelset[2].offset"]],
-        carrier: Some(|v, offsets| {
+        carrier: |v, offsets| {
             // The car body twice the car-body share per wheelset, the four-axle
             // wagon's body halved (docs/MODEL.md, The two-axle wagon).
             CarrierSpec::TwoAxle(TwoAxleParams {
@@ -167,7 +168,7 @@ pub const VEHICLE_KINDS: [VehicleKind; 4] = [
                 wheelbase: offsets[0],
                 gravity: v("gravity"),
             })
-        }),
+        },
     },
 ];
 
@@ -241,15 +242,11 @@ mod tests {
                 let s = table.vars.iter().find(|s| s.vr == vr).expect("of the FMU");
                 assert_eq!((s.min, s.max), wheelbase, "{}", k.fmu);
             }
-            match k.own_carrier(&start) {
-                None => assert_eq!(k.wheelsets, 1),
-                Some(c) => {
-                    let m = c.model();
-                    assert_eq!(m.wheelsets(), k.wheelsets, "{}", k.fmu);
-                    assert_eq!(m.offsets().len(), k.wheelsets - 1, "{}", k.fmu);
-                    m.validate().unwrap();
-                }
-            }
+            let c = k.own_carrier(&start);
+            let m = c.model();
+            assert_eq!(m.wheelsets(), k.wheelsets, "{}", k.fmu);
+            assert_eq!(m.offsets().len(), k.wheelsets - 1, "{}", k.fmu);
+            m.validate().unwrap();
         }
         // And every item of the enumeration is a kind.
         for (item, _) in vars::enums::vehicle_model::ITEMS {

@@ -360,6 +360,9 @@ impl CarrierModel for TwoAxleParams {
     fn static_wheel_load(&self) -> f64 {
         TwoAxleParams::static_wheel_load(self)
     }
+    fn stiffnesses(&self) -> Vec<(&'static str, f64)> {
+        vec![("vehicle.primary.stiffness", self.stiffness)]
+    }
     fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
         Ok(Box::new(TwoAxleWagon::new(*self, dt)?))
     }

@@ -221,6 +221,15 @@ impl CarrierModel for WagonParams {
     fn static_wheel_load(&self) -> f64 {
         WagonParams::static_wheel_load(self)
     }
+    fn stiffnesses(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("vehicle.primary.stiffness", self.bogie.primary_stiffness),
+            (
+                "vehicle.secondary.stiffness",
+                self.bogie.secondary_stiffness,
+            ),
+        ]
+    }
     fn whole(&self, dt: f64) -> Result<Box<dyn RailVehicle>> {
         Ok(Box::new(Wagon::new(*self, dt)?))
     }

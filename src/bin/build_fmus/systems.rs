@@ -285,23 +285,22 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
         value(track, "track.window.ahead", WINDOW),
         value(track, "track.window.behind", WINDOW),
     ];
-    // The vehicle's kind in the registry: on several wheelsets, the track carries its
-    // wheelsets at the offsets its own parameters give (the wheelbase, the wagon's
-    // bogie distance) and, at the axle boxes, what its kind has there.
+    // The vehicle's kind in the registry: the track carries its wheelsets at the
+    // offsets its own parameters give (the wheelbase, the wagon's bogie distance) and,
+    // at the axle boxes, what its kind has there.
     let kind = kind_of_fmu(vehicle.model_identifier).expect("a vehicle of the registry");
     let start = |name: &str| spec(vehicle, name).start;
-    if let Some(c) = kind.own_carrier(&start) {
-        track_values.push(value(track, "wheelsets", n as f64));
-        for ((x, _), k) in c.model().offsets().into_iter().zip(2..) {
-            track_values.push(value(track, &format!("wheelset[{k}].offset"), x));
-        }
-        let model = enums::vehicle_model::ITEMS
-            .iter()
-            .find(|(item, _)| *item == kind.item)
-            .expect("each kind is an item of VehicleModel")
-            .1;
-        track_values.push(value(track, "vehicle.model", model));
+    track_values.push(value(track, "wheelsets", n as f64));
+    let offsets = kind.own_carrier(&start).model().offsets();
+    for ((x, _), k) in offsets.into_iter().zip(2..) {
+        track_values.push(value(track, &format!("wheelset[{k}].offset"), x));
     }
+    let model = enums::vehicle_model::ITEMS
+        .iter()
+        .find(|(item, _)| *item == kind.item)
+        .expect("each kind is an item of VehicleModel")
+        .1;
+    track_values.push(value(track, "vehicle.model", model));
     let vehicle_values = vec![
         value(vehicle, "speed", speed),
         value(vehicle, "interface", interface.value()),

@@ -76,69 +76,49 @@ impl FmuModel {
                 .map_or(f64::NAN, |r| f(&r)),
             View::Vehicle(_) => f64::NAN,
         };
-        // The bodies of a vehicle on several wheelsets, where there is one
-        // (HalfCarBogie, Wagon, or CoupledSystem with vehicle.model = half_car or
-        // wagon).
-        let bodies = match view {
-            View::Vehicle(u) => u.bodies(),
-            View::Sim(sim, _) => sim.carrier().map(|b| b.bodies()),
+        // The vehicle that moves wheelset `index`'s wheels and the wheelset's index
+        // among its own: the vehicle unit's, or the simulation's (the vehicle on several
+        // wheelsets, or the wheelset's own roll-plane vehicle); `None` where nothing
+        // moves them (loads, external wheels, the axle-box interface's wheelsets).
+        let vehicle = match view {
+            View::Vehicle(_) => None,
+            View::Sim(sim, _) => sim.vehicle_of(index),
         };
         let w = index.min(crate::vehicle::MAX_AXLES - 1);
-        // The roll-plane vehicle's displacements `{z_b, phi_b, z_sfl, z_sfr, z_w,
-        // phi_w}` (0, 1, 4 and 5 read) with those of the bogie over wheelset `index` in
-        // their place.
-        let body = |k: usize| {
-            if let Some(b) = &bodies {
-                return match k {
-                    0 | 1 => b.bolster[w][k],
-                    _ => b.wheelset[w][k - 4],
-                };
-            }
-            match view {
-                View::Vehicle(u) => u.displacements()[k],
-                View::Sim(sim, _) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
-                    Some(VehicleState::RollPlane(v)) => v.displacements()[k],
-                    _ => f64::NAN,
-                },
-            }
+        let (bodies, w) = match (&view, vehicle) {
+            (View::Vehicle(u), _) => (Some(u.bodies()), w),
+            (View::Sim(..), Some((v, a))) => (Some(v.bodies()), a),
+            (View::Sim(..), None) => (None, w),
         };
-        // The side frames above wheelset `index`'s axle boxes: displacements and
-        // velocities.
-        let frames = || match view {
-            View::Vehicle(u) => u.side_frames_of(index),
-            View::Sim(sim, _) => {
-                match (
-                    sim.carrier(),
-                    sim.wheelsets().get(index).map(|w| w.vehicle()),
-                ) {
-                    (Some(b), _) => {
-                        let (z, v) = b.side_frames();
-                        Some((z[w], v[w]))
-                    }
-                    (None, Some(VehicleState::RollPlane(v))) => {
-                        let (d, v) = (v.displacements(), v.velocities());
-                        Some(([d[2], d[3]], [v[2], v[3]]))
-                    }
-                    _ => None,
-                }
+        // The bolster's (0, 1) and the wheelset's (4, 5) bounce and roll, as the
+        // roll-plane vehicle's `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` number them.
+        let body = |k: usize| match &bodies {
+            Some(b) => match k {
+                0 | 1 => b.bolster[w][k],
+                _ => b.wheelset[w][k - 4],
+            },
+            None => f64::NAN,
+        };
+        // The side frames (the suspension's upper ends) above wheelset `index`'s axle
+        // boxes: displacements and velocities.
+        let frames = || match (&view, vehicle) {
+            (View::Vehicle(u), _) => u.side_frames_of(index),
+            (View::Sim(..), Some((v, a))) => {
+                let (z, v) = v.side_frames();
+                Some((z[a], v[a]))
             }
+            (View::Sim(..), None) => None,
         };
         // The primary forces: the vehicle's, the axle-box interface's at the
         // communication point, or 0 where the track carries no primary suspension (TrackContact
         // with the contact interface).
-        let bearing = || match view {
-            View::Vehicle(u) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
-            View::Sim(sim, _) => {
-                match (
-                    sim.carrier(),
-                    sim.wheelsets().get(index).map(|w| w.vehicle()),
-                ) {
-                    (Some(b), _) => b.bearing_forces()[w][side],
-                    (None, Some(VehicleState::RollPlane(v))) => v.bearing_forces()[side],
-                    (None, Some(VehicleState::AxleBox(link))) => link.force_now()[side],
-                    _ => 0.0,
-                }
-            }
+        let bearing = || match (&view, vehicle) {
+            (View::Vehicle(u), _) => u.bearing_forces_of(index).map_or(0.0, |f| f[side]),
+            (View::Sim(..), Some((v, a))) => v.bearing_forces()[a][side],
+            (View::Sim(sim, _), None) => match sim.wheelsets().get(index).map(|w| w.vehicle()) {
+                Some(VehicleState::AxleBox(link)) => link.force_now()[side],
+                _ => 0.0,
+            },
         };
         // The axle-box interface's primary forces averaged since the last input.
         let mean_bearing = || match view {

@@ -13,10 +13,10 @@ use crate::fmu::vars::{
     enums, vr,
 };
 use crate::numerics::Table;
+use crate::sim::VehicleUnitParams;
 use crate::sim::{
     Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
-use crate::sim::{UnitModel, VehicleUnitParams};
 use crate::track::{
     RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
     TrackParams,
@@ -132,13 +132,12 @@ pub fn wheelset_params(v: &[f64]) -> RollPlaneParams {
 pub fn vehicle_unit_params(kind: Kind, v: &[f64]) -> VehicleUnitParams {
     let val = |r: u32| v[r as usize];
     let get = by_name(v);
-    let model = match kind.vehicle().and_then(|k| k.own_carrier(&get)) {
-        Some(c) => UnitModel::Carrier(c),
-        None => UnitModel::RollPlane,
-    };
-    let n = model.wheelsets();
+    let model = kind
+        .vehicle()
+        .expect("the vehicle unit of a vehicle's FMU")
+        .own_carrier(&get);
+    let n = model.model().wheelsets();
     VehicleUnitParams {
-        vehicle: vehicle_params(v),
         speed: val(vr::SPEED),
         wheel_radius: val(vr::WHEEL_RADIUS),
         dt: val(vr::SOLVER_DT),
@@ -198,10 +197,7 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
     let model = vehicle_model(v);
     let offsets: Vec<f64> = OFFSET_VRS.iter().map(|&r| val(r)).collect();
     let vehicle = match kind {
-        Kind::CoupledSystem => match model.carrier {
-            Some(build) => VehicleSpec::Carrier(build(&by_name(v), &offsets)),
-            None => VehicleSpec::RollPlane(vehicle_params(v)),
-        },
+        Kind::CoupledSystem => VehicleSpec::of_kind((model.carrier)(&by_name(v), &offsets)),
         _ if axle_box(v) => VehicleSpec::AxleBox {
             vehicle: wheelset_params(v),
             side_frames: match model.above_axle_boxes {
