@@ -53,6 +53,8 @@ pub use registry::{
     roll_plane,
 };
 pub use roll_plane::{BODY_DOFS, RollPlaneParams, RollPlaneVehicle, SprungBogie};
-pub use two_axle::{SprungTwoAxleWagon, TWO_AXLE_DOFS, TwoAxleParams, TwoAxleWagon};
+pub use two_axle::{
+    SprungTwoAxleWagon, TWO_AXLE_DOFS, TwoAxleParams, TwoAxleWagon, WHEELBASE_RANGE,
+};
 pub use wagon::{MIN_BOGIE_GAP, WAGON_DOFS, WagonMatrix, WagonParams, WagonVector, bogie_start};
 pub use wagon_motion::{Octet, SprungWagon, WAGON_DOF_NAMES, Wagon};

@@ -291,7 +291,14 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
     let kind = kind_of_fmu(vehicle.model_identifier).expect("a vehicle of the registry");
     let start = |name: &str| spec(vehicle, name).start;
     track_values.push(value(track, "wheelsets", n as f64));
-    let offsets = kind.own_carrier(&start).model().offsets();
+    let carrier = kind.own_carrier(&start);
+    // The vehicle's static wheel load, where the track starts at rest with it (no
+    // handshake in a master that does not run one).
+    let load = carrier.model().static_wheel_load();
+    for side in ["left", "right"] {
+        track_values.push(value(track, &format!("static_load.{side}"), load));
+    }
+    let offsets = carrier.model().offsets();
     for ((x, _), k) in offsets.into_iter().zip(2..) {
         track_values.push(value(track, &format!("wheelset[{k}].offset"), x));
     }
