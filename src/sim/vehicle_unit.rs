@@ -30,13 +30,13 @@ pub struct VehicleUnitParams {
     pub speed: f64,
     /// Nominal wheel radius `R_w` (m).
     pub wheel_radius: f64,
-    /// Base step (s); 0 takes the vehicle's [`CarrierModel::default_dt`].
+    /// Base step (s); 0 takes the vehicle's [`crate::vehicle::CarrierModel::default_dt`].
     pub dt: f64,
     /// Wheel-centre displacements `[left, right]` (m) of the static equilibrium, as the
     /// track computed them: the vehicle starts at rest on them.
     pub static_wheel_z: [f64; 2],
     /// The axle-box interface: the unit is the vehicle above its primary suspension
-    /// ([`CarrierModel::sprung`]), the primary forces come in
+    /// ([`crate::vehicle::CarrierModel::sprung`]), the primary forces come in
     /// (held over each communication step) and the side frames' motion goes out; its
     /// partner carries the wheelset and the primary suspension
     /// ([`crate::sim::VehicleSpec::AxleBox`]). `false`: the whole vehicle with the
