@@ -156,14 +156,19 @@ def shell_commands(lang, body):
 
 
 def collect():
-    """Every command of the pages, in order: (key, kind, text, where)."""
-    items, seen = [], set()
+    """Every command of the pages, in order: (key, kind, text, where). A command that
+    stands in several blocks is one; two Python blocks that begin alike but differ are
+    two (the later keyed by its place too), so neither goes unrun."""
+    items, seen, bodies = [], set(), {}
     for page in pages():
         text = open(os.path.join(ROOT, page)).read()
         for lang, body, line in fenced_blocks(text):
             if lang in ("python", "py"):
                 first = next(ln for ln in body.split("\n") if ln.strip())
-                entries = [("python: " + " ".join(re.sub(r"\s+#.*$", "", first).split()), "python", body)]
+                key = "python: " + " ".join(re.sub(r"\s+#.*$", "", first).split())
+                if bodies.setdefault(key, body) != body:
+                    key = f"{key} ({page}:{line})"
+                entries = [(key, "python", body)]
             else:
                 entries = [(key_of(c), "shell", c) for c in shell_commands(lang, body)]
             for key, kind, cmd in entries:

@@ -161,3 +161,23 @@ def test_a_suspension_too_soft_to_carry_the_wagon_is_named(paths, capfd):
         simulate_fmu(paths["TwoAxleWagon"], stop_time=0.01, start_values={"vehicle.primary.stiffness": 1e4})
     out = capfd.readouterr().out
     assert "the suspension is too soft to carry the vehicle (vehicle.primary.stiffness = 10000 N/m)" in out, out
+
+
+def test_its_declared_static_heights_are_the_tracks(paths, two_axle):
+    # The FMU starts at rest on static_wheel_z.* unless the master hands it the track's:
+    # its declared starts are TrackContact's static heights under its own static load
+    # and wheelbase (TrackContact's defaults otherwise), so a master that runs no
+    # handshake starts it at rest.
+    from fmpy import read_model_description
+    starts = {v.name: float(v.start) for v in read_model_description(paths["TwoAxleWagon"]).modelVariables
+              if v.start is not None}
+    names = wf.every_wheelset(2, ("static_wheel_z.left", "static_wheel_z.right"))
+    t = wf.Unit(paths["TrackContact"], "t")
+    t.fmu.setupExperiment(startTime=0.0)
+    t.set_parameters({"wheelsets": 2, "wheelset[2].offset": starts["wheelset[2].offset"],
+                      "static_load.left": STATIC_LOAD, "static_load.right": STATIC_LOAD})
+    t.fmu.enterInitializationMode()
+    heights = t.get(*names)
+    t.fmu.exitInitializationMode()
+    t.close()
+    assert [starts[n] for n in names] == pytest.approx(heights, abs=1e-12)
