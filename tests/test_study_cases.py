@@ -215,6 +215,15 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
     assert table["warnings"][1] == ""
 
 
+def vehicle_items():
+    """`1 = roll_plane, 2 = half_car, ...`: the VehicleModel items of the variable table,
+    as the refusal lists them."""
+    import re
+    text = open(os.path.join(ROOT, "modelDescription", "variables.xml")).read()
+    vm = re.search(r'<SimpleType name="VehicleModel".*?</SimpleType>', text, re.S).group(0)
+    return ", ".join(f"{v} = {n}" for n, v in re.findall(r'<Item name="(\w+)" value="(\d+)"', vm))
+
+
 @pytest.mark.parametrize("text, said", [
     ('name = "s"\nduration = 0.1\n[fixd]\nspeed = 20.0\n', "unknown keys ['fixd']"),
     ('name = "s"\nduration = 0.1\n[fixed]\nspeed = 20.0\n[sweep]\nspeed = [10.0]\n', "`speed` is both fixed and swept"),
@@ -288,8 +297,8 @@ def test_the_fmus_warnings_reach_the_tables_and_the_case_still_counts(tmp_path, 
      "`wheelsets` = 'two' is text (in quotes), but `wheelsets` takes a number: a whole number, 1 <= wheelsets <= 4"),
     # Issue 38 (item 3): an enumeration's name was refused as "not a table: no file at".
     ('name = "s"\nduration = 0.1\n[fixed]\n"vehicle.model" = "half_car"\n',
-     "`vehicle.model` = 'half_car' is text (in quotes), but `vehicle.model` takes a number: one of 1 = roll_plane, "
-     "2 = half_car, 3 = wagon (an enumeration: its number); for half_car write vehicle.model = 2"),
+     "`vehicle.model` = 'half_car' is text (in quotes), but `vehicle.model` takes a number: one of "
+     f"{vehicle_items()} (an enumeration: its number); for half_car write vehicle.model = 2"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = 20\n', "`rail.left.profile` = 20.0: a table"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = "0 0; 1 x"\n',
      "`rail.left.profile` (the table written out): line 1, its point 2 after a `;`: not two numbers (2 fields)"),
