@@ -7,7 +7,8 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
 from wheelflat_study import load_study, run_study  # noqa: E402, F401
-from wheelflat_study.run import ROOT, build_runner, load_done  # noqa: E402, F401
+from wheelflat_study.done import load_done  # noqa: E402, F401
+from wheelflat_study.run import ROOT, build_runner  # noqa: E402, F401
 from wheelflat_study.tables import TIMING  # noqa: E402
 
 STUDY = """

@@ -13,6 +13,8 @@ import sys
 import threading
 import time
 
+from .done import read_done
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 # The installed package's own case runner and FMUs (python/setup.py puts them there).
 DATA = os.path.join(HERE, "_data")
@@ -288,50 +290,6 @@ def described(ident):
     return f"version {ident[0]}, GUID {ident[1]}, engine {ident[2]}"
 
 
-def load_done(out_dir, retry_failed=False, ident=None, ids_only=False, offsets=False):
-    """The results already in the study's folder, by case id. Lines that are not a
-    whole record (cut by an interruption, or damaged) are skipped, so their cases run
-    again; so do cases that failed for a passing reason (a stopped runner, a lost
-    worker), with `retry_failed` every failed case, and, given `ident` (version, GUID,
-    engine fingerprint), results of another software version, GUID or engine (one
-    table holds one model's results); `load_done.other` counts those. ids_only: the
-    records' ids only (what a start needs; a million records' parameters would not fit
-    in the memory a start has); offsets: where each record starts in cases.jsonl
-    (bytes), for reading them one at a time."""
-    load_done.other = 0
-    path = os.path.join(out_dir, "cases.jsonl")
-    done = {}
-    # Ids whose latest record is another model's (a newer record of the id replaces it).
-    other = set()
-    if os.path.exists(path):
-        with open(path, "rb") as fh:
-            at = 0
-            for line in fh:
-                start, at = at, at + len(line)
-                try:
-                    rec = json.loads(line.decode("utf-8", errors="replace"))
-                except json.JSONDecodeError:
-                    continue
-                if not (isinstance(rec, dict) and isinstance(rec.get("id"), str)
-                        and isinstance(rec.get("result"), dict)):
-                    continue
-                cid, res = rec["id"], rec["result"]
-                if res.get("error") and (res.get("transient") or retry_failed):
-                    done.pop(cid, None)
-                    other.discard(cid)
-                    continue
-                # Every record names the model that made it (failures too); one without
-                # (written before the identities were kept) counts as another's.
-                if ident is not None and tuple(rec.get("identity") or ()) != tuple(ident):
-                    done.pop(cid, None)
-                    other.add(cid)
-                    continue
-                done[cid] = start if offsets else True if ids_only else rec
-                other.discard(cid)
-    load_done.other = len(other)
-    return done
-
-
 def _append(out_dir, records):
     path = os.path.join(out_dir, "cases.jsonl")
     # A line cut by an interruption is closed first, so the next record starts a line.
@@ -384,9 +342,10 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     # The command built the runner already (build_runner); a library call without one
     # takes this installation's, built only if there is none.
     ident, cost = warm_up(runner_path or default_runner() or build_runner())
-    done = set(load_done(out_dir, retry_failed, ident, ids_only=True))
-    if load_done.other:
-        log(f"{study.name}: {load_done.other} results of another software version, model GUID or engine in "
+    done, other = read_done(out_dir, retry_failed, ident, ids_only=True)
+    done = set(done)
+    if other:
+        log(f"{study.name}: {other} results of another software version, model GUID or engine in "
             f"{out_dir} are set aside and run again (this runner: {described(ident)})")
     total = study.count()
     have = sum(1 for c in study.iter_cases() if c.id in done) if done else 0

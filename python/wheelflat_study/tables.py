@@ -5,6 +5,7 @@ CSV, in the order of the study's cases."""
 import json
 import os
 
+from .done import load_done
 from .spec import Table
 
 # Columns that describe how a case ran, not what it gave: left out of comparisons.
@@ -95,7 +96,6 @@ def write_tables(study, out_dir, ident=None):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from .run import load_done
     offsets = load_done(out_dir, ident=ident, offsets=True)
     path = os.path.join(out_dir, "cases.jsonl")
 
