@@ -312,8 +312,11 @@ fn every_input_at_its_declared_start_is_accepted_and_an_input_never_set_reads_ba
             .iter()
             .filter(|v| v.causality == Causality::Input)
         {
+            // A vehicle's force input never set reads its forces at rest, which its
+            // declared start writes out: the same to the last bits, which the
+            // summation order of `K d - F` may move between builds (debug, release).
             let x = real(&mut i, v.vr);
-            if x != v.start {
+            if (x - v.start).abs() > 4.0 * f64::EPSILON * v.start.abs() {
                 off.push(format!("{} reads {x}, start {}", v.name, v.start));
             }
         }
