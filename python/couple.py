@@ -4,7 +4,8 @@ fmpy's FMU2Slave on the default scenario (table 4.4, 70 km/h, 100 mm x 1.5 mm ha
 flat on the left wheel), prints the peak contact force per wheel, writes the time
 histories as CSV and a plot of both contact forces as PNG.
 
-    python3 python/couple.py [--stop 0.8] [--step SECONDS] [--out out/]
+    python3 python/couple.py [--stop 0.8] [--step SECONDS] [--speed KMH]
+                             [--flat-length MM] [--flat-depth MM] [--out out/]
 
 Without --step the communication step is the track's internal step (solver.step), which
 gives exactly the numbers of the CoupledSystem FMU. Runs itself inside .venv (created on
@@ -25,14 +26,29 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--stop", type=float, default=0.8, help="simulated time (s)")
     ap.add_argument("--step", type=float, default=None, help="communication step (s); default: solver.step")
+    ap.add_argument("--speed", type=float, default=None, metavar="KMH",
+                    help="forward speed (km/h); default: the FMUs' speed (70 km/h)")
+    ap.add_argument("--flat-length", type=float, default=None, metavar="MM",
+                    help="length of the left wheel's flat (mm; 0: no flat); default: the FMUs' (100 mm)")
+    ap.add_argument("--flat-depth", type=float, default=None, metavar="MM",
+                    help="depth of the left wheel's flat (mm; 0: from its length, (2.10)); default: the FMUs' (1.5 mm)")
     ap.add_argument("--out", default=os.path.join(wf.ROOT, "out"), help="output folder")
     args = ap.parse_args()
 
     t0 = time.perf_counter()
     paths = wf.build_fmus()
     t1 = time.perf_counter()
-    r = wf.run_pair(paths, args.stop, args.step)
+    # The case: the FMUs' defaults, with what the options change (SI units).
+    track, both = {}, {}
+    if args.speed is not None:
+        both["speed"] = args.speed / 3.6
+    if args.flat_length is not None:
+        track["flat.left[1].length"] = args.flat_length / 1e3
+    if args.flat_depth is not None:
+        track["flat.left[1].depth"] = args.flat_depth / 1e3
+    r = wf.run_pair(paths, args.stop, args.step, track_params=dict(track, **both), vehicle_params=both)
     t2 = time.perf_counter()
+    case = wf.case_of(paths["TrackContact"], dict(track, **both))
 
     import numpy as np
     import matplotlib
@@ -50,13 +66,14 @@ def main():
     ax.plot(data[:, 0], data[:, 2] / 1e3, label="right wheel", lw=0.8)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("contact force (kN)")
-    ax.set_title("TrackContact + RollPlaneVehicle (fmpy FMU2Slave): table 4.4, 70 km/h, 100 mm x 1.5 mm flat")
+    ax.set_title(f"TrackContact + RollPlaneVehicle (fmpy FMU2Slave): table 4.4, {case}")
     ax.grid(True, alpha=0.3)
     ax.legend()
     fig.tight_layout()
     png = os.path.join(args.out, "coupled_pair.png")
     fig.savefig(png, dpi=120)
 
+    print(f"case: {case}")
     steps = len(r["time"]) - 1
     print(f"communication steps: {steps} of {args.stop / steps * 1e6:.3f} us" if steps else "no steps")
     print(f"peak contact force, left wheel:  {r['contact.left.max_force'][-1] / 1e3:9.2f} kN")

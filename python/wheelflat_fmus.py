@@ -192,6 +192,20 @@ def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
     track.fmu.exitInitializationMode()
 
 
+def case_of(track_fmu, params=None):
+    """The case in words, "70 km/h, 100 mm x 1.5 mm flat": TrackContact's speed and
+    its left wheel's first flat, its start values with `params` (SI units) set."""
+    from fmpy import read_model_description
+    start = {v.name: float(v.start) for v in read_model_description(track_fmu).modelVariables
+             if v.start is not None and v.type in ("Real", "Integer", "Enumeration")}
+    start.update(params or {})
+    speed = start["speed"] * 3.6
+    length, depth = start["flat.left[1].length"] * 1e3, start["flat.left[1].depth"] * 1e3
+    flat = "no flat" if length == 0 else (f"{length:g} mm x {depth:g} mm flat" if depth
+                                         else f"{length:g} mm flat, its depth from its length")
+    return f"{speed:g} km/h, {flat}"
+
+
 def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params=None,
              input_derivatives=False):
     """Couples TrackContact and RollPlaneVehicle; comm_step None takes the track's

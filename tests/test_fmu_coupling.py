@@ -520,3 +520,21 @@ def test_the_half_car_bogie_starts_at_rest_with_unset_inputs(paths):
         after = b.get(*names)
         assert np.max(np.abs(np.array(after) - before)) < 1e-9, (interface, before, after)
         b.close()
+
+
+def test_couple_py_runs_the_case_its_options_name(paths, tmp_path):
+    # Issue 40 (item 4): the main command takes the speed and the flat. The pair at the
+    # track's step is CoupledSystem, so its peaks are CoupledSystem's for the same case.
+    import sys
+    r = subprocess.run([sys.executable, os.path.join(wf.ROOT, "python", "couple.py"), "--stop", "0.05",
+                        "--speed", "100", "--flat-length", "60", "--flat-depth", "0.6", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    peaks = ["contact.left.max_force", "contact.right.max_force"]
+    ref = simulate_fmu(paths["CoupledSystem"], stop_time=0.05, output=peaks,
+                       start_values={"speed": 100 / 3.6, "flat.left[1].length": 0.06, "flat.left[1].depth": 0.0006})
+    assert "case: 100 km/h, 60 mm x 0.6 mm flat" in r.stdout, r.stdout
+    assert f"left wheel:  {ref[peaks[0]][-1] / 1e3:9.2f} kN" in r.stdout, r.stdout
+    assert f"right wheel: {ref[peaks[1]][-1] / 1e3:9.2f} kN" in r.stdout, r.stdout
+    # The defaults are the FMUs': the README's case.
+    assert wf.case_of(paths["TrackContact"]) == "70 km/h, 100 mm x 1.5 mm flat"

@@ -615,3 +615,24 @@ def test_a_run_of_hanging_sleepers_longer_than_the_track_is_refused_with_a_range
     assert "`track.void.sleepers` = 100 is out of range" in error and "track.void.sleepers <= 31" in error, error
     for lo, hi in re.findall(r"(-?\d[\d.e+-]*) m <= track\.void\.position < (-?\d[\d.e+-]*) m", error):
         assert float(lo) < float(hi), error
+
+
+def test_a_dry_run_prints_the_case_table_and_runs_nothing(tmp_path, runner):
+    # Issue 40 (item 4): --dry-run checks the study, prints every case (its id, the
+    # swept values in their display units) and stops; no runner runs, no folder is made.
+    p = tmp_path / "dry.toml"
+    p.write_text('name = "dry"\nduration = 0.05\n[sweep]\nspeed = { values = [36.0, 72.0], unit = "km/h" }\n'
+                 '"flat.left[1].length" = { values = [50.0, 100.0], unit = "mm" }\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    out = tmp_path / "never"
+    r = subprocess.run([sys.executable, "-m", "wheelflat_study", str(p), "--dry-run", "--out", str(out),
+                        "--runner", runner], env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.strip().split("\n")
+    assert lines[0] == "id\tspeed [km/h]\tflat.left[1].length [mm]", lines[0]
+    ids = [c.id for c in load_study(str(p)).cases()]
+    rows = [ln.split("\t") for ln in lines[1:-1]]
+    assert [row[0] for row in rows] == ids
+    assert [row[1:] for row in rows] == [["36", "50"], ["36", "100"], ["72", "50"], ["72", "100"]]
+    assert lines[-1].startswith("4 cases of 0.05 s") and "nothing was run" in lines[-1], lines[-1]
+    assert not out.exists()

@@ -16,7 +16,7 @@ import sys
 
 from .run import (MAX_TIME_LIMIT, MIN_TIME_LIMIT, ROOT, TIME_LIMIT_FACTOR, build_runner, installed, run_study,
                   stop_runners)
-from .spec import MAX_CASES, Table, Unread, _finite_text, load_study
+from .spec import MAX_CASES, Table, Unread, _finite_text, inline, load_study
 
 
 def main(argv=None):
@@ -55,6 +55,9 @@ def _main(argv=None):
                     help=f"wall time one case may take (s); a case past it is stopped and recorded as "
                          f"failed (default: {TIME_LIMIT_FACTOR:g} times its duration at the cost measured "
                          f"at the start, at least {MIN_TIME_LIMIT:g} s)")
+    ap.add_argument("--dry-run", action="store_true",
+                    help="check the study, print its case table (each case's id and the values it sweeps, in "
+                         "their display units) and stop, running nothing")
     ap.add_argument("--version", action="store_true", help="print the installed versions and GUIDs, then stop")
     ap.add_argument("--retry-failed", action="store_true",
                     help="run again the cases that failed (those that failed for a passing reason, "
@@ -126,6 +129,9 @@ def _main(argv=None):
     except RuntimeError as e:
         print(str(e), file=sys.stderr)
         return 2
+    if args.dry_run:
+        print_cases(study)
+        return 0
     out = args.out or os.path.join("results" if installed() else os.path.join(ROOT, "results"), study.name)
     try:
         os.makedirs(out, exist_ok=True)
@@ -165,6 +171,26 @@ def _main(argv=None):
                                 if missing else "") + ")")
     failed += missing
     return 1 if failed else 0
+
+
+def print_cases(study):
+    """The case table of `study` on standard output, tab-separated: `id` and each swept
+    variable, with its display unit (`speed [km/h]`), then the count and what every case
+    fixes; a table by its file's name (or `table`, written out) and content's hash."""
+    names = list(study.sweep)
+    head = ["id"] + [f"{n} [{study.display[n][0]}]" if n in study.display else n for n in names]
+    print("\t".join(head))
+
+    def text(name, v):
+        if hasattr(v, "sha256"):
+            return f"{v.name if not inline(v.name) else 'table'} ({v.key})" if v.text else "no table"
+        factor = study.display.get(name, (None, 1.0))[1]
+        return f"{v * factor:g}"
+
+    for case in study.iter_cases():
+        print("\t".join([case.id] + [text(n, case.params[n]) for n in names]))
+    fixed = ", ".join(f"{k} = {text(k, v)}" for k, v in study.fixed.items()) or "nothing"
+    print(f"{study.count()} cases of {study.duration:g} s; fixed: {fixed}; nothing was run (--dry-run)")
 
 
 def check_variables(study, runner):
