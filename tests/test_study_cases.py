@@ -5,6 +5,7 @@ past its time limit, the case ids) and the refusals of bad runners, counts and s
 files (issue 26). The runs on Dask are in test_study_runs.py; the helpers in
 study_helpers.py, the ``runner`` and ``study`` fixtures in conftest.py."""
 
+import json
 import os
 import subprocess
 import sys
@@ -27,6 +28,7 @@ def test_a_failing_case_is_recorded_and_the_study_goes_on(tmp_path, runner):
 
 # A runner lost on the first try of the 30 m/s case only (the marker file says it was).
 LOSING_ONCE_RUNNER = """\
+import json
 import os
 for line in sys.stdin:
     if "speed=30" in line and not os.path.exists({marker!r}):
@@ -636,3 +638,23 @@ def test_a_dry_run_prints_the_case_table_and_runs_nothing(tmp_path, runner):
     assert [row[1:] for row in rows] == [["36", "50"], ["36", "100"], ["72", "50"], ["72", "100"]]
     assert lines[-1].startswith("4 cases of 0.05 s") and "nothing was run" in lines[-1], lines[-1]
     assert not out.exists()
+
+
+def test_a_limit_runs_the_first_cases_and_the_same_command_without_it_the_rest(tmp_path, runner):
+    # Issue 40 (item 4): --limit N runs the study's first N cases, with the whole
+    # study's ids, so a run without it goes on with the others.
+    p = tmp_path / "lim.toml"
+    p.write_text('name = "lim"\nduration = 0.01\n[sweep]\nspeed = [20.0, 30.0, 40.0]\n')
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
+           "--no-progress", "--no-plots", "--runner", runner]
+    r = subprocess.run(cmd + ["--limit", "2"], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "(2 of 2 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
+    ids = [c.id for c in load_study(str(p)).cases()]
+    done = [json.loads(line)["id"] for line in open(tmp_path / "o" / "cases.jsonl")]
+    assert sorted(done) == sorted(ids[:2])
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "3 cases, 2 already done, 1 to run" in r.stdout + r.stderr, (r.stdout, r.stderr)
+    assert "(3 of 3 cases, 0 failed)" in r.stdout, r.stdout
+    r = subprocess.run(cmd + ["--limit", "0"], env=env, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "--limit 0: 1 to" in r.stderr, r.stderr

@@ -55,6 +55,9 @@ def _main(argv=None):
                     help=f"wall time one case may take (s); a case past it is stopped and recorded as "
                          f"failed (default: {TIME_LIMIT_FACTOR:g} times its duration at the cost measured "
                          f"at the start, at least {MIN_TIME_LIMIT:g} s)")
+    ap.add_argument("--limit", type=int, metavar="N",
+                    help="run the study's first N cases only (their ids are the whole study's: the same command "
+                         "without --limit goes on with the rest)")
     ap.add_argument("--dry-run", action="store_true",
                     help="check the study, print its case table (each case's id and the values it sweeps, in "
                          "their display units) and stop, running nothing")
@@ -91,7 +94,8 @@ def _main(argv=None):
     if limit is not None and not 0 < limit <= MAX_TIME_LIMIT:
         print(f"--case-time-limit {limit:g}: 0 < S <= {MAX_TIME_LIMIT:g} s", file=sys.stderr)
         return 2
-    for flag, v, most in (("--chunk", args.chunk, MAX_CASES), ("--workers", args.workers, 1024)):
+    for flag, v, most in (("--chunk", args.chunk, MAX_CASES), ("--workers", args.workers, 1024),
+                          ("--limit", args.limit, MAX_CASES)):
         if v is not None and not 1 <= v <= most:
             print(f"{flag} {v}: 1 to {most}", file=sys.stderr)
             return 2
@@ -129,6 +133,7 @@ def _main(argv=None):
     except RuntimeError as e:
         print(str(e), file=sys.stderr)
         return 2
+    study.limit = args.limit
     if args.dry_run:
         print_cases(study)
         return 0

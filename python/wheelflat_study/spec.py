@@ -144,6 +144,9 @@ class Study:
     keep: tuple = ()
     plots: list = field(default_factory=list)
     display: dict = field(default_factory=dict)  # name -> (unit, factor to the unit)
+    # The first `limit` cases only (the command's --limit; None: all): their ids are
+    # the whole study's, so a run without it goes on with the rest.
+    limit: int = None
 
     def __post_init__(self):
         # A study made in code, with a table's path or the table as text: read here,
@@ -154,11 +157,10 @@ class Study:
                       for k, v in self.sweep.items()}
 
     def count(self):
-        """The number of cases."""
+        """The number of cases (at most :attr:`limit`)."""
         lens = [len(v) for v in self.sweep.values()]
-        if self.combine == "zip":
-            return lens[0] if lens else 1
-        return math.prod(lens)
+        n = (lens[0] if lens else 1) if self.combine == "zip" else math.prod(lens)
+        return n if self.limit is None else min(n, self.limit)
 
     def _rows(self):
         lists = list(self.sweep.values())
@@ -215,7 +217,8 @@ class Study:
         sha1 = hashlib.sha1
         # A float's text is its repr; a table's, its content's hash (_repr).
         text_of = _repr if any(isinstance(x, Table) for v in self.sweep.values() for x in v) else repr
-        for row in self._rows():
+        rows = self._rows() if self.limit is None else itertools.islice(self._rows(), self.limit)
+        for row in rows:
             params = dict(self.fixed)
             params.update(zip(names, row))
             text = dict(fixed)
