@@ -508,4 +508,9 @@ def run_two_axle_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, w
 
 
 if __name__ == "__main__":
+    import argparse
+    argparse.ArgumentParser(
+        description="Sets up .venv at the repository's root with the packages of python/requirements.txt "
+                    "(fmpy, dask, pandas, pyarrow, libcosimpy, ecospy), which the other commands run in; "
+                    "imported, the coupling helpers (run_pair, run_carrier, run_carrier_axle_box, ...).").parse_args()
     install_venv()

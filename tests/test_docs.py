@@ -379,3 +379,21 @@ if __name__ == "__main__":
     for key, kind, cmd, where in COMMANDS:
         print(f"{where:40} {'mapped' if key in MAPPED else 'run':7} {key}")
     sys.exit(0)
+
+
+RELEASE = os.path.join(ROOT, os.environ.get("CARGO_TARGET_DIR") or "target", "release")
+
+
+@pytest.mark.parametrize("command", [
+    [os.path.join(RELEASE, "wheelflat")], [os.path.join(RELEASE, "wheelflat_case")],
+    [os.path.join(RELEASE, "build_fmus")],
+    [VENV_BIN + "/python", "python/couple.py"], [VENV_BIN + "/python", "python/wheelflat_fmus.py"],
+    [VENV_BIN + "/python", "-m", "wheelflat_study"],
+])
+def test_every_command_answers_help(command):
+    # Issue 40 (item 4): `--help` on every command prints its usage and changes nothing
+    # (build_fmus took it for its output folder).
+    env = dict(os.environ, PYTHONPATH=os.path.join(ROOT, "python"))
+    r = subprocess.run(command + ["--help"], cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "usage" in r.stdout.lower(), (r.returncode, r.stdout, r.stderr)
+    assert not os.path.exists(os.path.join(ROOT, "--help"))

@@ -469,9 +469,26 @@ fn case_id(line: &str) -> (Result<Option<String>, String>, String) {
 }
 
 fn main() {
-    if std::env::args().nth(1).as_deref() == Some("--variables") {
-        list_variables();
-        return;
+    match std::env::args().nth(1).as_deref() {
+        Some("--variables") => {
+            list_variables();
+            return;
+        }
+        Some("--help" | "-h") => {
+            println!(
+                "usage: wheelflat_case [--variables]\n\
+                 Runs cases of CoupledSystem read from standard input, one per line of NAME=VALUE \
+                 tokens with duration=S (and keep=OUT1,OUT2, case=ID), answering one JSON line \
+                 each; --variables lists CoupledSystem's parameters, inputs and outputs with \
+                 their ranges. The sweep command (python -m wheelflat_study) drives it."
+            );
+            return;
+        }
+        Some(a) => {
+            eprintln!("wheelflat_case: {a}: no such option (--help, --variables)");
+            std::process::exit(2);
+        }
+        None => {}
     }
     let mut stdin = std::io::stdin().lock();
     let mut out = std::io::stdout().lock();

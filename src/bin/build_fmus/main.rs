@@ -88,7 +88,21 @@ fn stripped(lib: &Path, out: &Path) -> Result<Vec<u8>, Box<dyn std::error::Error
     Ok(bytes)
 }
 
+/// The usage line of `--help`.
+const USAGE: &str = "usage: build_fmus [OUT_DIR [VARIABLES.md]]\n\
+    Packs the FMUs into OUT_DIR (default fmu/ of the checkout): each FMU, the C header, the \
+    system files (systems/) and fmus.json; VARIABLES.md: where to write the variables' \
+    documentation. Run after cargo build --release (the library beside this program, or \
+    $WHEELFLAT_FMU_LIBRARY); scripts/build_fmus_glibc228.sh is the project's one build.";
+
 fn run() -> Result<(), Box<dyn std::error::Error>> {
+    if let Some(a) = std::env::args().nth(1).filter(|a| a.starts_with('-')) {
+        if a == "--help" || a == "-h" {
+            println!("{USAGE}");
+            return Ok(());
+        }
+        return Err(format!("{a}: no such option\n{USAGE}").into());
+    }
     let out: PathBuf = std::env::args()
         .nth(1)
         .map(PathBuf::from)
