@@ -59,7 +59,10 @@ def main():
     cols = ["time"] + list(wf.TRACK_RECORD) + list(wf.WHEELS)
     data = np.column_stack([np.asarray(r[c]) for c in cols])
     csv = os.path.join(args.out, "coupled_pair.csv")
-    np.savetxt(csv, data, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
+    # Each column with its unit, as the model descriptions declare it ("contact.left.force [N]").
+    units = wf.units_of([paths["TrackContact"], paths["RollPlaneVehicle"]])
+    header = ",".join(["time [s]"] + [f"{c} [{units[c]}]" if units.get(c) else c for c in cols[1:]])
+    np.savetxt(csv, data, delimiter=",", header=header, comments="", fmt="%.17g")
 
     fig, ax = plt.subplots(figsize=(9, 4.5))
     ax.plot(data[:, 0], data[:, 1] / 1e3, label="left wheel (flat)", lw=0.8)

@@ -192,6 +192,17 @@ def initialise_pair(track, vehicle, track_params=None, vehicle_params=None):
     track.fmu.exitInitializationMode()
 
 
+def units_of(fmus):
+    """Every variable's unit ("N", "m", "rad"; "" where it has none) in the model
+    descriptions of the FMUs at the paths `fmus`, by name."""
+    from fmpy import read_model_description
+    units = {}
+    for path in fmus:
+        for v in read_model_description(path).modelVariables:
+            units.setdefault(v.name, v.unit or (v.declaredType.unit if v.declaredType else None) or "")
+    return units
+
+
 def case_of(track_fmu, params=None):
     """The case in words, "70 km/h, 100 mm x 1.5 mm flat": TrackContact's speed and
     its left wheel's first flat, its start values with `params` (SI units) set."""

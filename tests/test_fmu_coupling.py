@@ -538,3 +538,7 @@ def test_couple_py_runs_the_case_its_options_name(paths, tmp_path):
     assert f"right wheel: {ref[peaks[1]][-1] / 1e3:9.2f} kN" in r.stdout, r.stdout
     # The defaults are the FMUs': the README's case.
     assert wf.case_of(paths["TrackContact"]) == "70 km/h, 100 mm x 1.5 mm flat"
+    # Every column of the CSV carries its unit, the model descriptions'.
+    header = open(tmp_path / "coupled_pair.csv").readline().strip().split(",")
+    assert header[:3] == ["time [s]", "contact.left.force [N]", "contact.right.force [N]"], header
+    assert header[-1] == "wheel.rotation [rad]" and all(h.endswith("]") for h in header), header
