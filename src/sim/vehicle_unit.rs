@@ -166,25 +166,26 @@ impl VehicleUnit {
         };
         // At rest beyond the health bounds: the suspension does not carry the vehicle
         // (not the forces, which are the static ones here).
-        if let Err(Error::Diverged {
-            what, value, limit, ..
-        }) = unit.check_states()
-        {
-            let stiffnesses = c
-                .stiffnesses()
-                .iter()
-                .map(|(name, k)| format!("{name} = {} N/m", num(*k)))
-                .collect::<Vec<_>>()
-                .join(", ");
-            return Err(Error::Unsupported(format!(
-                "static equilibrium of the vehicle: at rest {what} = {} beyond {}, which no \
-                 physical run reaches: the suspension is too soft to carry the vehicle \
-                 ({stiffnesses}); stiffer springs carry it",
-                num(value),
-                num(limit),
-            )));
+        match unit.check_states() {
+            Err(Error::Diverged {
+                what, value, limit, ..
+            }) => {
+                let stiffnesses = c
+                    .stiffnesses()
+                    .iter()
+                    .map(|(name, k)| format!("{name} = {} N/m", num(*k)))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                return Err(Error::Unsupported(format!(
+                    "static equilibrium of the vehicle: at rest {what} = {} beyond {}, which no \
+                     physical run reaches: the suspension is too soft to carry the vehicle \
+                     ({stiffnesses}); stiffer springs carry it",
+                    num(value),
+                    num(limit),
+                )));
+            }
+            other => other?,
         }
-        unit.check_states()?;
         Ok(unit)
     }
 

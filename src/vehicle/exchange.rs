@@ -112,10 +112,10 @@ where
         for (w, aw) in a.iter_mut().enumerate().take(P::WHEELSETS) {
             *aw = [f[2 * w], f[2 * w + 1]];
         }
-        SprungLinearBody::step_boxes(self, &a);
+        SprungVehicle::step(self, &a);
     }
     fn state(&self) -> Vec<f64> {
-        self.integrator_state()
+        SprungVehicle::state_vector(self)
     }
     fn set_state(&mut self, v: &[f64]) {
         self.set_integrator_displacements(v);

@@ -184,6 +184,38 @@ pub(super) fn wheels_beyond(z: &Axles, wheelsets: usize) -> Option<(&'static str
         .find(|&(_, x, l)| !within(x, l))
 }
 
+/// What building either body refuses: a parameter [`LinearVehicle::validate`] refuses;
+/// `dt` (s) not positive or above [`LinearVehicle::critical_time_step`].
+fn check_new<P: LinearVehicle<N, S>, const N: usize, const S: usize>(
+    params: &P,
+    dt: f64,
+) -> Result<()> {
+    params.validate()?;
+    positive("solver.dt", dt, "s")?;
+    params.check_time_step(dt)
+}
+
+/// Changes the step of either body's stepper `cd` to `dt` (s), checked against the
+/// whole vehicle's critical step.
+fn change_dt_of<P: LinearVehicle<N, S>, const N: usize, const S: usize, const M: usize>(
+    cd: &mut CentralDifference<M>,
+    params: &P,
+    dt: f64,
+) -> Result<()> {
+    cd.change_dt_checked(dt, |h| params.check_time_step(h))
+}
+
+/// Restores either body's stepper `cd` from its state vector `v`, the length refused
+/// naming the vehicle.
+fn restore_of<P: LinearVehicle<N, S>, const N: usize, const S: usize, const M: usize>(
+    cd: &mut CentralDifference<M>,
+    params: &P,
+    v: &[f64],
+) -> Result<()> {
+    let what = format!("{} state length", P::WHAT);
+    cd.restore(v, &what, |h| params.check_time_step(h))
+}
+
 /// A linear vehicle in time: its `N` degrees of freedom under gravity and the contact
 /// forces of its wheels.
 #[derive(Debug, Clone)]
@@ -201,9 +233,7 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> LinearBody<P, N, S>
     /// Errors: a parameter [`LinearVehicle::validate`] refuses; `dt` not positive or
     /// above [`LinearVehicle::critical_time_step`].
     pub fn new(params: P, dt: f64) -> Result<Self> {
-        params.validate()?;
-        positive("solver.dt", dt, "s")?;
-        params.check_time_step(dt)?;
+        check_new(&params, dt)?;
         let mut body = LinearBody {
             params,
             cd: CentralDifference::new(
@@ -296,8 +326,7 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> RailVehicle for Lin
         Ok(self.params.static_contact_forces(&d))
     }
     fn change_dt(&mut self, dt: f64) -> Result<()> {
-        let p = self.params;
-        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))?;
+        change_dt_of(&mut self.cd, &self.params, dt)?;
         self.set_constant();
         Ok(())
     }
@@ -305,9 +334,7 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> RailVehicle for Lin
         self.cd.state_vector()
     }
     fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let p = self.params;
-        let what = format!("{} state length", P::WHAT);
-        self.cd.restore(v, &what, |h| p.check_time_step(h))?;
+        restore_of(&mut self.cd, &self.params, v)?;
         self.set_constant();
         Ok(())
     }
@@ -339,9 +366,7 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> SprungLinearBody<P,
     /// Errors: as [`LinearBody::new`] (the step is checked against the whole vehicle's
     /// critical step).
     pub fn new(params: P, dt: f64) -> Result<Self> {
-        params.validate()?;
-        positive("solver.dt", dt, "s")?;
-        params.check_time_step(dt)?;
+        check_new(&params, dt)?;
         let (k, c) = params.above_primary();
         let (m, g) = (params.mass_diagonal(), params.gravity_force());
         let sub = |a: SMatrix<f64, N, N>| {
@@ -431,16 +456,13 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> SprungVehicle
             .primary_forces(d.as_slice(), SVector::<f64, N>::zeros().as_slice()))
     }
     fn change_dt(&mut self, dt: f64) -> Result<()> {
-        let p = self.params;
-        self.cd.change_dt_checked(dt, |h| p.check_time_step(h))
+        change_dt_of(&mut self.cd, &self.params, dt)
     }
     fn state_vector(&self) -> Vec<f64> {
         self.cd.state_vector()
     }
     fn set_state_vector(&mut self, v: &[f64]) -> Result<()> {
-        let p = self.params;
-        let what = format!("{} state length", P::WHAT);
-        self.cd.restore(v, &what, |h| p.check_time_step(h))
+        restore_of(&mut self.cd, &self.params, v)
     }
     fn beyond_bounds(&self) -> Option<(&'static str, f64, f64)> {
         bodies_beyond(&self.cd, |i| P::DOF_NAMES[P::SPRUNG[i]])
@@ -454,17 +476,8 @@ impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> SprungVehicle
 }
 
 impl<P: LinearVehicle<N, S>, const N: usize, const S: usize> SprungLinearBody<P, N, S> {
-    /// One substep under the primary forces `f` at the axle boxes, for the exchange's
-    /// estimate (as [`SprungVehicle::step`]).
-    pub(super) fn step_boxes(&mut self, f: &Axles) {
-        SprungVehicle::step(self, f)
-    }
-    /// `[dt, d, d_prev]`.
-    pub(super) fn integrator_state(&self) -> Vec<f64> {
-        self.cd.state_vector()
-    }
-    /// Sets the displacements of [`SprungLinearBody::integrator_state`] (the step
-    /// unchanged).
+    /// Sets the displacements of [`SprungVehicle::state_vector`] `v` (the step
+    /// unchanged), for the exchange's estimate.
     pub(super) fn set_integrator_displacements(&mut self, v: &[f64]) {
         self.cd.set_displacements_from(v)
     }

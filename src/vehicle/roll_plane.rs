@@ -42,6 +42,36 @@ pub struct RollPlaneParams {
 }
 
 impl RollPlaneParams {
+    /// A wheelset of `wheelset_mass` (kg) and roll inertia `wheelset_inertia` (kg m^2) on
+    /// its primary suspension, `primary` = `(K_1` (N/m), `C_1` (N s/m), `L_w` (m)`)`,
+    /// under gravity `gravity` (m/s^2), the bodies above it zero: what the track side
+    /// carries at the axle-box interface ([`super::PrimaryLink`] uses no more).
+    pub fn wheelset_on_primary(
+        wheelset_mass: f64,
+        wheelset_inertia: f64,
+        primary: (f64, f64, f64),
+        gravity: f64,
+    ) -> RollPlaneParams {
+        let (primary_stiffness, primary_damping, primary_spacing) = primary;
+        RollPlaneParams {
+            carbody_mass: 0.0,
+            bolster_mass: 0.0,
+            bolster_inertia: 0.0,
+            sideframe_mass: 0.0,
+            wheelset_mass,
+            wheelset_inertia,
+            primary_stiffness,
+            primary_damping,
+            primary_spacing,
+            secondary_stiffness: 0.0,
+            secondary_damping: 0.0,
+            secondary_spacing: 0.0,
+            gravity,
+        }
+    }
+}
+
+impl RollPlaneParams {
     /// Checks every parameter.
     pub fn validate(&self) -> Result<()> {
         for (name, value) in [

@@ -315,21 +315,12 @@ impl TwoAxleParams {
     /// The wheelset and its suspension, in the roll-plane vehicle's parameters, as the
     /// track side carries them ([`super::PrimaryLink`] uses no more).
     pub fn wheelset(&self) -> RollPlaneParams {
-        RollPlaneParams {
-            carbody_mass: 0.0,
-            bolster_mass: 0.0,
-            bolster_inertia: 0.0,
-            sideframe_mass: 0.0,
-            wheelset_mass: self.wheelset_mass,
-            wheelset_inertia: self.wheelset_inertia,
-            primary_stiffness: self.stiffness,
-            primary_damping: self.damping,
-            primary_spacing: self.spacing,
-            secondary_stiffness: 0.0,
-            secondary_damping: 0.0,
-            secondary_spacing: 0.0,
-            gravity: self.gravity,
-        }
+        RollPlaneParams::wheelset_on_primary(
+            self.wheelset_mass,
+            self.wheelset_inertia,
+            (self.stiffness, self.damping, self.spacing),
+            self.gravity,
+        )
     }
 }
 

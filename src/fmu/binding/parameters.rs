@@ -111,21 +111,16 @@ pub fn axle_box(v: &[f64]) -> bool {
 /// unused).
 pub fn wheelset_params(v: &[f64]) -> RollPlaneParams {
     let v = |r: u32| v[r as usize];
-    RollPlaneParams {
-        carbody_mass: 0.0,
-        bolster_mass: 0.0,
-        bolster_inertia: 0.0,
-        sideframe_mass: 0.0,
-        wheelset_mass: v(vr::VEHICLE_WHEELSET_MASS),
-        wheelset_inertia: v(vr::VEHICLE_WHEELSET_INERTIA),
-        primary_stiffness: v(vr::VEHICLE_PRIMARY_STIFFNESS),
-        primary_damping: v(vr::VEHICLE_PRIMARY_DAMPING),
-        primary_spacing: v(vr::VEHICLE_PRIMARY_SPACING),
-        secondary_stiffness: 0.0,
-        secondary_damping: 0.0,
-        secondary_spacing: 0.0,
-        gravity: v(vr::GRAVITY),
-    }
+    RollPlaneParams::wheelset_on_primary(
+        v(vr::VEHICLE_WHEELSET_MASS),
+        v(vr::VEHICLE_WHEELSET_INERTIA),
+        (
+            v(vr::VEHICLE_PRIMARY_STIFFNESS),
+            v(vr::VEHICLE_PRIMARY_DAMPING),
+            v(vr::VEHICLE_PRIMARY_SPACING),
+        ),
+        v(vr::GRAVITY),
+    )
 }
 
 /// The vehicle as a co-simulation unit (the own FMU of a kind of vehicle).
