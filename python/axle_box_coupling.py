@@ -48,9 +48,9 @@ def main():
     t2 = time.perf_counter()
     peak_contact = [contact["contact.left.max_force"][-1], contact["contact.right.max_force"][-1]]
     print(f"axle-box interface, {args.step * 1e3:g} ms steps: peak left {peak_box[0] / 1e3:.1f} kN, "
-          f"right {peak_box[1] / 1e3:.1f} kN ({len(record)} steps, {t1 - t0:.1f} s)")
+          f"right {peak_box[1] / 1e3:.1f} kN ({len(record)} steps)")
     print(f"contact interface, the track's step: peak left {peak_contact[0] / 1e3:.1f} kN, "
-          f"right {peak_contact[1] / 1e3:.1f} kN ({len(contact['time']) - 1} steps, {t2 - t1:.1f} s)")
+          f"right {peak_contact[1] / 1e3:.1f} kN ({len(contact['time']) - 1} steps)")
     for side, a, b in (("left", peak_box[0], peak_contact[0]), ("right", peak_box[1], peak_contact[1])):
         print(f"difference, {side}: {(a - b) / 1e3:+.2f} kN ({100 * (a / b - 1):+.2f} %)")
 
@@ -75,6 +75,7 @@ def main():
     png = os.path.join(args.out, "axle_box_coupling.png")
     fig.savefig(png, dpi=120)
     print(f"wrote {csv} and {png}")
+    print(f"wall time: {t2 - t0:.1f} s")
 
 
 if __name__ == "__main__":

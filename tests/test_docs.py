@@ -34,7 +34,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV_BIN = os.path.join(ROOT, ".venv", "bin")
 # The guide's pages in reading order (a study's results are read after it has run);
 # pages added later come after these.
-PAGE_ORDER = ["README.md", "docs/guide/README.md", "docs/guide/couple-a-vehicle.md", "docs/guide/masters.md",
+PAGE_ORDER = ["README.md", "docs/guide/README.md", "docs/guide/quickstart.md", "docs/guide/couple-a-vehicle.md", "docs/guide/masters.md",
               "docs/guide/studies.md", "docs/guide/results.md", "docs/guide/fmus.md"]
 # A command run here must finish within this (s); a longer one belongs in MAPPED.
 QUICK_S = 60
@@ -226,6 +226,38 @@ def test_a_command_of_the_guide_runs(runner, key):
         assert rc == 0, f"{NEEDS[key]} (needed first) failed:\n{out[-3000:]}"
     rc, out, seconds = runner(key)
     assert rc == 0, f"`{key}` exited with {rc} after {seconds:.1f} s:\n{out[-3000:]}"
+
+
+def transcript_items():
+    """(key, page:line, the lines shown) of each console block that shows one command's output."""
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    import wheelflat_figures as figures
+    for page in pages():
+        text = open(os.path.join(ROOT, page)).read()
+        for cmd, shown, (first, _) in figures.transcripts(text):
+            yield key_of(cmd), f"{page}:{first}", shown
+
+
+TRANSCRIPTS = list(transcript_items())
+
+
+@pytest.mark.parametrize("key,where,shown", TRANSCRIPTS, ids=[f"{w} {k[:50]}" for k, w, _ in TRANSCRIPTS])
+def test_a_transcript_shows_what_its_command_prints(runner, key, where, shown):
+    # Issue 40 (items 1, 2): a console block's output is what the command prints on this
+    # build, figure by figure (python/wheelflat_figures.py writes it; the stated rounding
+    # is its same_figure's). A block without output lines is filled by that command.
+    import wheelflat_figures as figures
+    assert shown, f"{where}: `{key}` shows no output: run python3 python/wheelflat_figures.py"
+    rc, out, _ = runner(key)
+    assert rc == 0, out[-3000:]
+    diff = figures.same_transcript(shown, out)
+    assert diff is None, f"{where}: `{key}`: {diff}\n(python3 python/wheelflat_figures.py writes what it prints)"
+
+
+def test_every_python_test_file_is_on_the_test_commands_pytest_line():
+    # tests/test_two_axle.py was left off it once, and ran nowhere.
+    files = {os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "tests", "test_*.py"))}
+    assert files - pytest_line() == set()
 
 
 def pytest_line():

@@ -266,11 +266,8 @@ front_angle_right_rad,rear_angle_right_rad,contact_length_left_m,contact_length_
             side(1)
         );
     }
-    eprintln!(
-        "{} steps in {:.2} s; wrote {output}",
-        total,
-        start.elapsed().as_secs_f64()
-    );
+    eprintln!("{total} steps; wrote {output}");
+    eprintln!("wall time: {:.2} s", start.elapsed().as_secs_f64());
     Ok(())
 }
 

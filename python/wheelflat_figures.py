@@ -1,0 +1,460 @@
+#!/usr/bin/env python3
+"""Every figure README.md and the guide quote, printed by the build, not typed.
+
+    python3 python/wheelflat_figures.py           # regenerate every figure in place
+    python3 python/wheelflat_figures.py --check   # compare only: exit 1 naming each stale one
+    python3 python/wheelflat_figures.py --only pair,speed_flat   # some sources only
+
+Run it after a change that moves a result (a default, the model, a master's recipe),
+read the diff, and commit it with a line in CHANGELOG.md. The test command checks
+(tests/test_figures.py, tests/test_docs.py) that the committed figures are what the
+current build gives. What it regenerates, from the FMUs in fmu/ and the runner in
+target/release/ (built first if missing):
+
+1. Figures in the prose, between markers ``<!--fig NAME-->301.92 kN<!--/fig-->``, and
+   generated blocks (tables) between ``<!--generated NAME-->`` and ``<!--/generated-->``,
+   in README.md, docs/guide/*.md and docs/STUDIES.md. NAME's first word names its
+   source in SOURCES (``pair.left`` comes from ``pair``).
+2. Transcripts: each ```console block of those pages whose first line is ``$ COMMAND``
+   shows below it what COMMAND prints (cargo's status lines left out). A line that
+   begins ``wall time`` is compared up to its colon only, and a time written as
+   pytest writes it (``0.53s``) not at all.
+3. The studies' plots in docs/studies/ (each studies/*.toml run serially), each PNG
+   carrying the digest of its study's results table, so a plot from an older model is
+   found.
+4. The regression kit in regression/ (python/wheelflat_kit.py).
+
+The stated rounding: a figure is compared as printed, number by number; a number may
+differ from the committed one by one unit in its last printed digit (a rounding
+boundary crossed on a machine with another vector width), no more.
+"""
+
+import argparse
+import hashlib
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import wheelflat_fmus as wf  # noqa: E402
+
+ROOT = wf.ROOT
+# The pages, with docs/guide/*.md after the first; a Python file quotes figures in its comments.
+PAGES = ["README.md", "docs/STUDIES.md", "python/quickstart/test_regression.py"]
+VENV_BIN = os.path.join(ROOT, ".venv", "bin")
+MARKER = re.compile(r"<!--(fig|generated) ([\w.\-\[\]]+)-->(.*?)<!--/\1-->", re.S)
+NUMBER = re.compile(r"[+-]?\d[\d,]*(?:\.\d+)?")
+# A time as pytest and cargo print it, "0.53s": not compared.
+SECONDS = re.compile(r"\b\d+(?:\.\d+)?s\b")
+CARGO_STATUS = re.compile(r"^\s+(Compiling|Finished|Running|Blocking|Updating|Downloaded|Downloading|Locking)\b")
+STUDY_PLOTS = os.path.join(ROOT, "docs", "studies")
+# The digest of a study's results, kept in each of its PNG plots (a tEXt chunk).
+DIGEST_KEY = "wheelflat-results"
+
+
+def pages():
+    guide = sorted(os.path.relpath(p, ROOT) for p in
+                   __import__("glob").glob(os.path.join(ROOT, "docs", "guide", "*.md")))
+    return PAGES[:1] + guide + PAGES[1:]
+
+
+# ---------------------------------------------------------------------------- sources
+# Each source runs once and returns {name: text}; the pages quote its names.
+
+def kn(x, digits=2):
+    return f"{x / 1e3:.{digits}f} kN"
+
+
+def runner():
+    """The command-line runner (target/release/wheelflat), built when missing."""
+    path = os.path.join(wf.TARGET_DIR, "release", "wheelflat")
+    if not os.path.exists(path):
+        subprocess.run(["cargo", "build", "--release", "--bin", "wheelflat"], cwd=ROOT, check=True)
+    return path
+
+
+def fmu_paths():
+    """The FMUs in fmu/ by name (the command builds them first; the tests use the
+    test command's)."""
+    return {name: os.path.join(wf.FMU_DIR, name + ".fmu") for name in wf.registry()["fmus"]}
+
+
+def run_runner(*args):
+    """The runner's case line, static load and peaks: {static, left, right} in N."""
+    with tempfile.TemporaryDirectory() as tmp:
+        p = subprocess.run([runner(), *args, "--output", os.path.join(tmp, "run.csv")], cwd=tmp,
+                           check=True, capture_output=True, text=True)
+        out = p.stdout + p.stderr
+    static = float(re.search(r"static wheel load ([\d.]+) kN", out).group(1)) * 1e3
+    m = re.search(r"peak impact force: left ([\d.]+) kN .*right ([\d.]+) kN", out)
+    return {"static": static, "left": float(m.group(1)) * 1e3, "right": float(m.group(2)) * 1e3}
+
+
+def source_pair():
+    """The reference case (table 4.4, 70 km/h, 100 mm x 1.5 mm flat on the left wheel,
+    the FMUs' defaults) through TrackContact + RollPlaneVehicle at the track's step,
+    0.8 s, and through CoupledSystem."""
+    from fmpy import simulate_fmu
+    paths = fmu_paths()
+    r = wf.run_pair(paths, 0.8)
+    left, right = r["contact.left.max_force"][-1], r["contact.right.max_force"][-1]
+    static = r["contact.left.force"][0]
+    c = simulate_fmu(paths["CoupledSystem"], stop_time=0.8,
+                     output=["contact.left.max_force", "contact.right.max_force"])
+    return {
+        "pair.static": kn(static), "pair.left": kn(left), "pair.right": kn(right),
+        "pair.left.short": kn(left, 1), "pair.right.short": kn(right, 1),
+        "pair.left.ratio": f"{left / static:.2f}", "pair.right.ratio": f"{right / static:.2f}",
+        "pair.steps": f"{len(r['time']) - 1}",
+        "coupled.left": kn(c["contact.left.max_force"][-1]), "coupled.right": kn(c["contact.right.max_force"][-1]),
+    }
+
+
+def source_seed():
+    """The thesis' grid (n = 2, dt = 45 us) on its fixed track: the rail between nodes
+    by (3.23), as the thesis, and by its shape (the default)."""
+    linear = run_runner("--n", "2", "--dt-us", "45", "--between-nodes", "linear")
+    beam = run_runner("--n", "2", "--dt-us", "45")
+    return {
+        "seed.left": kn(linear["left"], 1), "seed.right": kn(linear["right"], 1),
+        "seed.right.ratio": f"{linear['right'] / linear['static']:.2f}",
+        "seed.beam.left": kn(beam["left"], 1),
+    }
+
+
+def study_table(study_file):
+    """Runs a study serially in a temporary folder: (the Study, its results table, the
+    folder's plots {name: path}, the folder, kept until the caller removes it)."""
+    sys.path.insert(0, os.path.join(ROOT, "python"))
+    from wheelflat_study.spec import load_study
+    from wheelflat_study.run import run_study
+    study = load_study(study_file)
+    tmp = tempfile.mkdtemp(prefix="figures_")
+    table, _ = run_study(study, tmp, serial=True, progress=False, plots=True, log=lambda *a: None)
+    return study, table, tmp
+
+
+def digest(table, columns):
+    text = table.sort_values(columns).to_csv(columns=columns, index=False, float_format="%.6e")
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def source_speed_flat():
+    """studies/speed_flat.toml: the headline plot (README), its table in STUDIES.md and
+    what the caption says of the study."""
+    import shutil
+    study, table, tmp = study_table(os.path.join(ROOT, "studies", "speed_flat.toml"))
+    try:
+        ok = table[table["status"] == "ok"]
+        lengths = sorted(ok["flat.left[1].length"].unique())
+        speeds = sorted(ok["speed"].unique())
+        head = "| km/h | " + " | ".join(f"{l * 1e3:g} mm" for l in lengths) + " |"
+        rows = [head, "|" + "---|" * (len(lengths) + 1)]
+        for v in speeds:
+            cells = [f"{ok[(ok['speed'] == v) & (ok['flat.left[1].length'] == l)]['peak.left'].iloc[0] / 1e3:.1f}"
+                     for l in lengths]
+            rows.append(f"| {v * 3.6:.0f} | " + " | ".join(cells) + " |")
+        radius = wf_start("wheel.radius")
+        depths = ", ".join(f"{l * l / (16 * radius) * 1e3:.2f}" for l in lengths)
+        fixed = study.fixed
+        at = lambda v, l: ok[(abs(ok["speed"] * 3.6 - v) < 1e-9) & (abs(ok["flat.left[1].length"] - l) < 1e-12)]
+        figures = {
+            "speed_flat.table": "\n\n" + "\n".join(rows) + "\n\n",
+            "speed_flat.cases": f"{len(ok)}",
+            "speed_flat.depths": f"{depths} mm",
+            "speed_flat.window": f"{fixed['track.window.ahead']:g} m",
+            "speed_flat.duration": f"{study.duration:g} s",
+            "speed_flat.100mm_70": kn(at(70, 0.1)["peak.left"].iloc[0], 1),
+            "speed_flat.100mm_140": kn(at(140, 0.1)["peak.left"].iloc[0], 1),
+        }
+        write_plots(study, ok, tmp)
+        return figures
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def wf_start(name):
+    """A start value of TrackContact's model description."""
+    from fmpy import read_model_description
+    md = read_model_description(os.path.join(wf.FMU_DIR, "TrackContact.fmu"))
+    return float(next(v.start for v in md.modelVariables if v.name == name))
+
+
+# The plots each study draws into docs/studies/ (its [[plot]] names).
+def write_plots(study, ok, tmp):
+    """Puts the study's PNG plots into docs/studies/ (write mode) or checks that the
+    committed ones carry the digest of these results (check mode)."""
+    from PIL import Image, PngImagePlugin
+    # The results, not the times they took.
+    cols = [c for c in ok.columns if ok[c].dtype.kind == "f" and not c.endswith("wall_s")]
+    d = digest(ok, sorted(cols))
+    for p in study.plots:
+        name = p.get("name")
+        committed = os.path.join(STUDY_PLOTS, f"{name}.png")
+        if CHECKING:
+            have = Image.open(committed).text.get(DIGEST_KEY) if os.path.exists(committed) else None
+            if have != d:
+                STALE.append(f"docs/studies/{name}.png: drawn from other results (digest {have}, "
+                             f"the current build's {d}): run python3 python/wheelflat_figures.py")
+            continue
+        info = PngImagePlugin.PngInfo()
+        info.add_text(DIGEST_KEY, d)
+        Image.open(os.path.join(tmp, f"{name}.png")).save(committed, pnginfo=info)
+
+
+def markdown_table(head, rows):
+    return "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+                     + ["| " + " | ".join(r) + " |" for r in rows])
+
+
+def study_source(study_name, tables):
+    """A source that runs studies/<study_name>.toml, puts its plots into docs/studies/
+    and gives `tables(ok)`'s figures ({name: text}, names under `study_name.`)."""
+    def source():
+        import shutil
+        study, table, tmp = study_table(os.path.join(ROOT, "studies", f"{study_name}.toml"))
+        try:
+            ok = table[table["status"] == "ok"]
+            write_plots(study, ok, tmp)
+            return {f"{study_name}.{k}": v for k, v in tables(study, ok).items()}
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    return source
+
+
+def impact_position_tables(study, ok):
+    rows, spreads = [], []
+    for v, g in ok.groupby("speed", sort=True):
+        lo = g.loc[g["first_impact_peak.left"].idxmin()]
+        hi = g.loc[g["first_impact_peak.left"].idxmax()]
+        spread = hi["first_impact_peak.left"] / lo["first_impact_peak.left"] - 1
+        spreads.append(spread)
+        rows.append([f"{v * 3.6:.0f}",
+                     f"{lo['first_impact_peak.left'] / 1e3:.1f}, {lo['first_impact_span_position.left']:.2f}",
+                     f"{hi['first_impact_peak.left'] / 1e3:.1f}, {hi['first_impact_span_position.left']:.2f}",
+                     f"{100 * spread:.0f} %"])
+    head = ["km/h", "least peak (kN), at", "largest peak (kN), at", "spread"]
+    return {"table": "\n\n" + markdown_table(head, rows) + "\n\n",
+            "spread": f"{100 * min(spreads):.0f} to {100 * max(spreads):.0f} %"}
+
+
+def flat_phase_tables(study, ok):
+    import math
+    rows, ratios = [], []
+    for v, g in ok.groupby("speed", sort=True):
+        phase = ((g["flat.right[1].angle"] - g["flat.left[1].angle"]) % (2 * math.pi))
+        zero = g[phase.abs() < 1e-9]["peak.max"].iloc[0]
+        worst = g.loc[g["peak.max"].idxmax()]
+        ratios.append(worst["peak.max"] / zero)
+        at = math.degrees((worst["flat.right[1].angle"] - worst["flat.left[1].angle"]) % (2 * math.pi))
+        rows.append([f"{v * 3.6:.0f}", f"{zero / 1e3:.1f}", f"{worst['peak.max'] / 1e3:.1f}, {at:.0f} deg",
+                     f"{worst['peak.max'] / zero:.2f}"])
+    head = ["km/h", "phase 0 (kN)", "worst phase (kN), at", "worst / phase 0"]
+    return {"table": "\n\n" + markdown_table(head, rows) + "\n\n",
+            "most": f"{100 * (max(ratios) - 1):.0f} %"}
+
+
+def primary_stiffness_tables(study, ok):
+    speeds = sorted(ok["speed"].unique())
+    rows = []
+    for k, g in ok.groupby("vehicle.primary.stiffness", sort=True):
+        by = {v: g[g["speed"] == v].iloc[0] for v in speeds}
+        rows.append([f"{k / 1e6:g}"] + [f"{by[v]['bearing.left.max'] / 1e3:.1f}" for v in speeds]
+                    + [f"{by[v]['peak.left'] / 1e3:.1f}" for v in speeds])
+    head = (["K_1 (MN/m)"] + [f"bearing, {v * 3.6:.0f} km/h" for v in speeds]
+            + [f"contact, {v * 3.6:.0f} km/h" for v in speeds])
+    # From the thesis' chapter-5 stiffness to table 4.4's, at each speed.
+    at = lambda k, v: ok[(abs(ok["vehicle.primary.stiffness"] - k) < 1) & (ok["speed"] == v)].iloc[0]
+    stiff, soft = 788e6, 6.5e6
+    falls = [(at(stiff, v)["bearing.left.max"], at(soft, v)["bearing.left.max"], v) for v in speeds]
+    rises = [at(soft, v)["peak.left"] / at(stiff, v)["peak.left"] - 1 for v in speeds]
+    fall = " and ".join(f"from {a / 1e3:.0f} to {b / 1e3:.0f} kN ({v * 3.6:.0f} km/h)" for a, b, v in falls)
+    pct = sorted(100 * (1 - b / a) for a, b, _ in falls)
+    return {"table": "\n\n" + markdown_table(head, rows) + "\n\n",
+            "bearing_fall": f"{fall}, {pct[0]:.0f} to {pct[-1]:.0f} %",
+            "contact_rise": f"{100 * min(rises):.0f} to {100 * max(rises):.0f} %"}
+
+
+def source_regression():
+    """The references of quick start (d), python/quickstart/test_regression.py: each of
+    its cases through CoupledSystem, as the test runs it."""
+    sys.path.insert(0, os.path.join(ROOT, "python", "quickstart"))
+    import test_regression as t
+    lines = []
+    for case in sorted(t.REFERENCE):
+        r = t.run(*case)
+        left, right = r["contact.left.max_force"][-1], r["contact.right.max_force"][-1]
+        lines.append(f"    {case}: ({left / 1e3:.1f}e3, {right / 1e3:.1f}e3),")
+    # Between the markers' comment lines, in the dict's indentation.
+    return {"regression.references": "\n" + "\n".join(lines) + "\n    # "}
+
+
+SOURCES = {
+    "regression": source_regression,
+    "pair": source_pair,
+    "seed": source_seed,
+    "speed_flat": source_speed_flat,
+    "impact_position": study_source("impact_position", impact_position_tables),
+    "flat_phase": study_source("flat_phase", flat_phase_tables),
+    "primary_stiffness": study_source("primary_stiffness", primary_stiffness_tables),
+}
+CHECKING = False
+STALE = []
+
+
+# ---------------------------------------------------------------------------- markers
+
+def markers(text):
+    """(kind, name, committed text, span) of each marker of a page."""
+    return [(m.group(1), m.group(2), m.group(3), m.span(3)) for m in MARKER.finditer(text)]
+
+
+def same_figure(committed, current):
+    """Equal as printed, but for one unit in the last printed digit of a number."""
+    if committed == current:
+        return True
+    a, b = NUMBER.findall(committed), NUMBER.findall(current)
+    if len(a) != len(b) or NUMBER.sub("#", committed) != NUMBER.sub("#", current):
+        return False
+    for x, y in zip(a, b):
+        x, y = x.replace(",", ""), y.replace(",", "")
+        digits = len(x.split(".")[1]) if "." in x else 0
+        if ("." in y and len(y.split(".")[1]) != digits) or abs(float(x) - float(y)) > 1.01 * 10 ** -digits:
+            return False
+    return True
+
+
+# ---------------------------------------------------------------------------- transcripts
+
+def transcripts(text):
+    """(command, output lines, (first, last) line index of the output) of each console
+    block whose first line is ``$ COMMAND`` and that shows one command."""
+    out, lines, i = [], text.split("\n"), 0
+    while i < len(lines):
+        if lines[i].strip() == "```console":
+            j = i + 1
+            while not lines[j].startswith("```"):
+                j += 1
+            body = lines[i + 1:j]
+            if body and body[0].startswith("$ ") and sum(ln.startswith("$ ") for ln in body) == 1:
+                out.append((body[0][2:].strip(), body[1:], (i + 2, j)))
+            i = j
+        i += 1
+    return out
+
+
+def printed(output):
+    """What a transcript shows of a command's output: cargo's status lines left out."""
+    return [ln.rstrip() for ln in output.rstrip("\n").split("\n") if not CARGO_STATUS.match(ln)]
+
+
+def same_transcript(shown, output):
+    """Whether a transcript shows `output` (a line beginning ``wall time`` compared up
+    to its colon); the first difference in words, or None."""
+    got = printed(output)
+    if len(shown) != len(got):
+        return f"{len(shown)} lines shown, {len(got)} printed:\n" + "\n".join(got)
+    for s, g in zip(shown, got):
+        if s.startswith("wall time") and g.startswith("wall time"):
+            if s.split(":")[0] != g.split(":")[0]:
+                return f"shown `{s}`, printed `{g}`"
+        elif not same_figure(SECONDS.sub("#s", s.rstrip()), SECONDS.sub("#s", g)):
+            return f"shown `{s}`, printed `{g}`"
+    return None
+
+
+def run_command(cmd, timeout=600):
+    env = dict(os.environ, PATH=VENV_BIN + os.pathsep + os.environ.get("PATH", ""), MPLBACKEND="Agg")
+    env.pop("PYTHONPATH", None)
+    p = subprocess.run(["bash", "-c", cmd], cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout)
+    if p.returncode != 0:
+        raise RuntimeError(f"`{cmd}` exited with {p.returncode}:\n{(p.stdout + p.stderr)[-3000:]}")
+    return p.stdout + p.stderr
+
+
+# ---------------------------------------------------------------------------- the command
+
+def figures_wanted(texts, only=None):
+    names = {name for t in texts.values() for _, name, _, _ in markers(t)}
+    sources = {n.split(".")[0] for n in names} | {s for s in SOURCES if not s.startswith(("pair", "seed"))}
+    unknown = sorted(n for n in names if n.split(".")[0] not in SOURCES)
+    if unknown:
+        raise SystemExit(f"unknown figures (no source in SOURCES): {unknown}")
+    return sorted(s for s in sources if only is None or s in only)
+
+
+def compute(sources, log=print):
+    figures = {}
+    for s in sources:
+        t0 = time.perf_counter()
+        figures.update(SOURCES[s]())
+        log(f"{s}: {time.perf_counter() - t0:.1f} s")
+    return figures
+
+
+def check(only=None, log=print):
+    """The stale figures and plots, as messages (empty when all are current)."""
+    global CHECKING
+    CHECKING, STALE[:] = True, []
+    texts = {p: open(os.path.join(ROOT, p)).read() for p in pages()}
+    figures = compute(figures_wanted(texts, only), log)
+    stale = list(STALE)
+    for page, text in texts.items():
+        for kind, name, committed, _ in markers(text):
+            if name in figures and not same_figure(committed, figures[name]):
+                stale.append(f"{page}: {name} reads {committed.strip()!r}; the current build gives "
+                             f"{figures[name].strip()!r}")
+            elif name not in figures and (only is None or name.split(".")[0] in only):
+                stale.append(f"{page}: {name}: its source gives no such figure")
+    CHECKING = False
+    return stale
+
+
+def write(only=None, transcripts_too=True, log=print):
+    texts = {p: open(os.path.join(ROOT, p)).read() for p in pages()}
+    figures = compute(figures_wanted(texts, only), log)
+    for page, text in texts.items():
+        new = MARKER.sub(lambda m: f"<!--{m.group(1)} {m.group(2)}-->{figures.get(m.group(2), m.group(3))}"
+                                   f"<!--/{m.group(1)}-->", text)
+        if transcripts_too and only is None:
+            lines = new.split("\n")
+            for cmd, _, (a, b) in reversed(transcripts(new)):
+                t0 = time.perf_counter()
+                lines[a:b] = printed(run_command(cmd))
+                log(f"{page}: $ {cmd}: {time.perf_counter() - t0:.1f} s")
+            new = "\n".join(lines)
+        if new != text:
+            with open(os.path.join(ROOT, page), "w") as fh:
+                fh.write(new)
+            log(f"wrote {page}")
+    kit = os.path.join(ROOT, "python", "wheelflat_kit.py")
+    if os.path.exists(kit) and only is None:
+        run_command(f"python3 python/wheelflat_kit.py write")
+        log("wrote the regression kit (regression/)")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--check", action="store_true", help="compare only; exit 1 naming each stale figure")
+    ap.add_argument("--only", default=None, help=f"comma-separated sources of {', '.join(SOURCES)}")
+    args = ap.parse_args(argv)
+    wf.ensure_venv()
+    wf.build_fmus()
+    only = None if args.only is None else set(args.only.split(","))
+    if only and only - set(SOURCES):
+        ap.error(f"--only: unknown source {sorted(only - set(SOURCES))}; known: {', '.join(SOURCES)}")
+    if args.check:
+        stale = check(only)
+        for s in stale:
+            print(f"stale: {s}")
+        print("every figure is current" if not stale else f"{len(stale)} stale figures")
+        return 1 if stale else 0
+    write(only)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
