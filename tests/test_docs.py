@@ -210,8 +210,10 @@ def runner(tmp_path_factory):
         argv = [os.path.join(VENV_BIN, "python"), "-c", cmd] if kind == "python" else ["bash", "-c", cmd]
         t0 = time.perf_counter()
         try:
-            p = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True, timeout=QUICK_S)
-            result = (p.returncode, p.stdout + p.stderr, time.perf_counter() - t0)
+            # One stream, as a terminal shows it: a transcript's lines in their order.
+            p = subprocess.run(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               text=True, timeout=QUICK_S)
+            result = (p.returncode, p.stdout, time.perf_counter() - t0)
         except subprocess.TimeoutExpired:
             result = (None, f"still running after {QUICK_S} s: map it in MAPPED to the test that runs it", QUICK_S)
         done[key] = result
