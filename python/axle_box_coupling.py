@@ -59,7 +59,9 @@ def main():
     import matplotlib.pyplot as plt
     os.makedirs(args.out, exist_ok=True)
     data = np.asarray(record)
-    cols = "time,contact.left.force,contact.right.force,primary.left.mean_force,primary.right.mean_force"
+    # Each column with its unit, as couple.py's.
+    cols = ("time [s],contact.left.force [N],contact.right.force [N],primary.left.mean_force [N],"
+            "primary.right.mean_force [N]")
     csv = os.path.join(args.out, "axle_box_coupling.csv")
     np.savetxt(csv, data, delimiter=",", header=cols, comments="", fmt="%.17g")
     fig, ax = plt.subplots(figsize=(9, 4.5))

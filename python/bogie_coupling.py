@@ -65,7 +65,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     data = np.column_stack([np.asarray(r["time"])] + [np.asarray(r[k]) for k in names])
     csv = os.path.join(args.out, "bogie_coupling.csv")
-    np.savetxt(csv, data, delimiter=",", header="time," + ",".join(names), comments="", fmt="%.17g")
+    np.savetxt(csv, data, delimiter=",", header="time [s]," + ",".join(f"{n} [N]" for n in names), comments="", fmt="%.17g")
     fig, ax = plt.subplots(figsize=(9, 4.5))
     for k, label in zip(range(1, 5), ["front, left (flat)", "front, right", "rear, left", "rear, right"]):
         ax.plot(data[:, 0], data[:, k] / 1e3, lw=0.8, label=label)

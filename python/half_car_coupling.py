@@ -69,7 +69,7 @@ def main():
     names = ["contact.left.force", "contact.right.force",
              "wheelset[2].contact.left.force", "wheelset[2].contact.right.force"]
     csv = os.path.join(args.out, "half_car_coupling.csv")
-    np.savetxt(csv, data, delimiter=",", header=",".join(["time"] + names), comments="", fmt="%.17g")
+    np.savetxt(csv, data, delimiter=",", header=",".join(["time [s]"] + [f"{n} [N]" for n in names]), comments="", fmt="%.17g")
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for ax, col, title in ((axes[0], 1, "leading wheelset, left wheel (the flat)"),
                            (axes[1], 3, "trailing wheelset, left wheel")):

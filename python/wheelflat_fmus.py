@@ -62,13 +62,18 @@ def install_venv():
     stamp = os.path.join(VENV, ".requirements")
     wanted = open(REQUIREMENTS).read()
     if not (os.path.exists(stamp) and open(stamp).read() == wanted):
+        import time
+        t0 = time.perf_counter()
         print("setting up .venv (python/requirements.txt: fmpy, numpy, matplotlib, pytest, dask, "
-              "libcosimpy, ecospy, ...) ...", file=sys.stderr)
+              "libcosimpy, ecospy, ...; pip's progress follows) ...", file=sys.stderr, flush=True)
         if not os.path.exists(venv_python()):
             venv.create(VENV, with_pip=True)
-        subprocess.check_call([venv_python(), "-m", "pip", "install", "-q", "-r", REQUIREMENTS])
+        # pip's lines (one per package) on stderr: this command's output stays its own.
+        subprocess.check_call([venv_python(), "-m", "pip", "install", "--progress-bar", "off",
+                               "--disable-pip-version-check", "-r", REQUIREMENTS], stdout=sys.stderr)
         with open(stamp, "w") as f:
             f.write(wanted)
+        print(f".venv ready in {time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
 
 
 def ensure_venv():
@@ -86,7 +91,12 @@ def build_fmus():
     progress on stderr, the packer's list dropped); the FMUs by name. Installed from the
     wheel: the FMUs that came with it, built the same way."""
     if CHECKOUT:
+        import time
+        t0 = time.perf_counter()
         subprocess.check_call(["bash", BUILD_SCRIPT, FMU_DIR], cwd=ROOT, stdout=subprocess.DEVNULL)
+        if time.perf_counter() - t0 > 10:  # a build that did work: its stage and time
+            print(f"built and packed the FMUs into {os.path.relpath(FMU_DIR)} in "
+                  f"{time.perf_counter() - t0:.0f} s", file=sys.stderr, flush=True)
     return {name: os.path.join(FMU_DIR, name + ".fmu") for name in registry()["fmus"]}
 
 

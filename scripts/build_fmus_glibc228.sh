@@ -31,8 +31,9 @@ fi
 command -v objdump >/dev/null || { echo "error: objdump (binutils) is needed to check the glibc baseline" >&2; exit 1; }
 export PATH="$(cd "$tools/ziglang" && pwd):$(cd "$tools/bin" && pwd):$PATH"
 triple=x86_64-unknown-linux-gnu
-cargo zigbuild --release --lib --bin build_fmus --bin wheelflat_case --target "$triple.$baseline"
 built="$target_dir/$triple/release"
+[ -e "$built/libwheelflat.so" ] || echo "build_fmus_glibc228.sh: first build of the FMUs' library, packer and case runner (cargo-zigbuild; about two minutes on 2 cores, cargo's progress follows)" >&2
+cargo zigbuild --release --lib --bin build_fmus --bin wheelflat_case --target "$triple.$baseline"
 # The packer packs the library beside it (target/x86_64-unknown-linux-gnu/release/).
 WHEELFLAT_FMU_LIBRARY="$built/libwheelflat.so" "$built/build_fmus" "$out"
 for f in "$built/libwheelflat.so" "$built/wheelflat_case"; do

@@ -658,3 +658,31 @@ def test_a_limit_runs_the_first_cases_and_the_same_command_without_it_the_rest(t
     assert "(3 of 3 cases, 0 failed)" in r.stdout, r.stdout
     r = subprocess.run(cmd + ["--limit", "0"], env=env, capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--limit 0: 1 to" in r.stderr, r.stderr
+
+
+def test_every_csv_column_names_its_unit(tmp_path, runner):
+    # Issue 40 (item 4): units in every CSV header ("peak.left [N]"); the Parquet tables
+    # keep the plain names. A runner field or parameter without a known unit fails here.
+    import pandas as pd
+    from wheelflat_study.tables import declared_units, unit_of
+    p = tmp_path / "units.toml"
+    p.write_text('name = "units"\nduration = 0.3\nkeep = ["primary.left.force"]\n'
+                 '[fixed]\n"track.window.ahead" = 8.0\n[sweep]\nspeed = { values = [70], unit = "km/h" }\n')
+    out = tmp_path / "o"
+    table, n = run_study(load_study(p), str(out), serial=True, runner_path=runner, progress=False, plots=False,
+                         log=lambda *_: None)
+    assert n == 1 and list(table["status"]) == ["ok"]
+    declared = declared_units()
+    for name in ("results", "impacts"):
+        plain = list(pd.read_parquet(out / f"{name}.parquet").columns)
+        assert [c for c in plain if unit_of(c, declared) is None] == [], name
+        header = list(pd.read_csv(out / f"{name}.csv").columns)
+        assert len(header) == len(plain)
+    results = list(pd.read_csv(out / "results.csv").columns)
+    for col in ("speed [m/s]", "track.window.ahead [m]", "peak.left [N]", "bearing.left.max [N]",
+                "primary.left.force.max [N]", "contact_loss.left [s]", "duration [s]", "status", "impacts.left"):
+        assert col in results, results
+    impacts = list(pd.read_csv(out / "impacts.csv").columns)
+    assert "peak [N]" in impacts and "time [s]" in impacts and "span_position" in impacts
+    # The same numbers under both names.
+    assert pd.read_csv(out / "results.csv")["peak.left [N]"][0] == table["peak.left"][0]

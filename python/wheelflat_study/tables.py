@@ -35,6 +35,51 @@ def _flatten(res):
     return row
 
 
+# The unit of each column the case runner's result gives (src/bin/wheelflat_case.rs
+# documents its fields), by the column's name with the wheel or side left out; a
+# parameter's and a kept output's unit is the one CoupledSystem's model description
+# declares. Counts, fractions and text have none.
+RESULT_UNITS = {"peak": "N", "impact_peak": "N", "first_impact_peak": "N", "bearing": "N", "contact_loss": "s",
+                "duration": "s", "runner_wall_s": "s", "wall_s": "s", "time": "s", "passage": "s"}
+NO_UNIT = {"impacts", "first_impact_span_position", "span_position", "k"}
+
+
+def unit_of(name, declared):
+    """The unit of a table's column `name` ("" for none): a parameter's or a kept
+    output's (``NAME.max``, ``NAME.min``) as `declared` (name -> unit) says, else the
+    runner's field's; None for a column no list knows (tests/test_study_cases.py holds
+    every column of a study to a known unit)."""
+    if name in TEXT or name.endswith(".sha256"):
+        return ""
+    base = name[:-4] if name.endswith((".max", ".min")) and name[:-4] in declared else name
+    if base in declared:
+        return declared[base]
+    head = name.split(".")[0]
+    if head in RESULT_UNITS:
+        return RESULT_UNITS[head]
+    return "" if head in NO_UNIT else None
+
+
+def declared_units():
+    """Every variable's unit in CoupledSystem's model description, by name ({} without the FMU)."""
+    try:
+        from fmpy import read_model_description
+        from . import fmu_paths
+        md = read_model_description(fmu_paths()["CoupledSystem"])
+    except Exception:
+        return {}
+    return {v.name: v.unit or (v.declaredType.unit if v.declaredType else None) or "" for v in md.modelVariables}
+
+
+def csv_header(names, declared):
+    """The CSV header: each column with its unit, ``peak.left [N]`` (Parquet keeps the names)."""
+    out = []
+    for n in names:
+        u = unit_of(n, declared)
+        out.append(f"{n} [{u}]" if u else n)
+    return out
+
+
 # Columns that hold text; every other column is a float64 (an impact's `k` an int64).
 TEXT = ("case_id", "status", "error", "warnings", "version", "guid", "engine", "wheel")
 # Rows a batch of the tables holds: the tables are written a batch at a time, so the
@@ -141,7 +186,8 @@ def write_tables(study, out_dir, ident=None):
             writers[name] = (pq.ParquetWriter(os.path.join(out_dir, f"{name}.parquet.part"), sch),
                              open(os.path.join(out_dir, f"{name}.csv.part"), "w", newline=""))
         batch = {"results": [], "impacts": []}
-        header = {"results": True, "impacts": True}
+        declared = declared_units()
+        header = {name: csv_header(names, declared) for name, (names, _) in tables.items()}
 
         def flush(name):
             names, sch = tables[name]
@@ -150,8 +196,8 @@ def write_tables(study, out_dir, ident=None):
                 if n not in text and n != "k":
                     df[n] = df[n].astype("float64")
             writers[name][0].write_table(pa.Table.from_pandas(df, schema=sch, preserve_index=False))
-            df.to_csv(writers[name][1], index=False, header=header[name], float_format="%.17g")
-            header[name] = False
+            df.to_csv(writers[name][1], index=False, header=header[name] or False, float_format="%.17g")
+            header[name] = None
             batch[name] = []
 
         # Second pass: the rows, a batch at a time.
