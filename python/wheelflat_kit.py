@@ -346,42 +346,13 @@ def copy_fmus(fmu_dir=None, kit_dir=None):
     return copies
 
 
-def _validate_signal(t, y, t_ref, y_ref, t_start, t_stop, num=1000, dx=21, dy=0.1):
-    """fmpy.cross_check.validate_signal in numpy alone, for where scipy is missing: the
-    same band (the reference resampled on `num` points, widened by `dx` samples and by
-    `dy` of its range) and the same outliers; scipy's minimum_filter1d/maximum_filter1d
-    ('reflect' mode) are a sliding window over the band mirrored at its ends."""
-    import numpy as np
-    t_band = np.linspace(start=t_start, stop=t_stop, num=num)
-    m = np.concatenate(([True], np.diff(t_ref) > 0))
-    y_band = np.interp(x=t_band, xp=t_ref[m], fp=y_ref[m])
-    lo, hi = np.min(y_band), np.max(y_band)
-    if lo == hi:
-        w = 0.5 if lo == 0 else np.abs(lo) * dy
-    else:
-        w = (hi - lo) * dy
-    windows = np.lib.stride_tricks.sliding_window_view(np.pad(y_band, dx // 2, mode="symmetric"), dx)
-    y_min = windows.min(axis=1) - w
-    y_max = windows.max(axis=1) + w
-    y_min_i = np.interp(x=t, xp=t_band, fp=y_min)
-    y_max_i = np.interp(x=t, xp=t_band, fp=y_max)
-    i_out = np.logical_or(y < y_min_i, y > y_max_i)
-    i_out = np.logical_and(i_out, t >= t_start)
-    i_out = np.logical_and(i_out, t <= t_stop)
-    return t_band, y_min, y_max, i_out
-
-
 def validate_signal(**kw):
-    """fmpy.cross_check.validate_signal (the Cross-Check's band), or its numpy copy
-    where scipy, which it needs, is missing."""
-    try:
-        import scipy.ndimage  # noqa: F401
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", DeprecationWarning)  # its scipy.ndimage.filters
-            from fmpy.cross_check import validate_signal as fmpy_validate_signal
-            return fmpy_validate_signal(**kw)
-    except ImportError:
-        return _validate_signal(**kw)
+    """fmpy.cross_check.validate_signal, the Cross-Check's band (it needs scipy, which
+    python/requirements.txt pins)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # its scipy.ndimage.filters
+        from fmpy.cross_check import validate_signal as fmpy_validate_signal
+        return fmpy_validate_signal(**kw)
 
 
 def compare(model, result, reference, opt, tolerance=TOLERANCE, units=None):

@@ -23,13 +23,6 @@ SCRIPT = os.path.join(wf.ROOT, "python", "wheelflat_kit.py")
 FMA = os.path.exists("/proc/cpuinfo") and " fma" in open("/proc/cpuinfo").read()
 
 
-def has_scipy():
-    try:
-        import scipy.ndimage  # noqa: F401
-        return True
-    except ImportError:
-        return False
-
 
 @pytest.fixture(scope="module")
 def fmus():
@@ -165,22 +158,6 @@ def test_the_check_refuses_to_set_an_input_and_names_a_model_it_lacks(fmus):
     assert report["Bogie"][0].startswith("Bogie: --set names no FMU of the kit")
 
 
-@pytest.mark.skipif(not has_scipy(), reason="fmpy's validate_signal needs scipy")
-def test_the_numpy_band_is_fmpys(fmus):
-    import warnings
-    from fmpy.cross_check import validate_signal
-    from fmpy.util import read_csv
-    warnings.filterwarnings("ignore", category=DeprecationWarning)  # its scipy.ndimage.filters
-    ref = read_csv(kit.files(KIT, "CoupledSystem")["ref"])
-    t = ref["time"]
-    for name in ref.dtype.names[1:]:
-        y = ref[name]
-        for z in (y, y * 1.05, np.roll(y, 7), y + 0.2 * (y.max() - y.min()) * np.sin(300 * t)):
-            kw = dict(t=t, y=z, t_ref=t.copy(), y_ref=y, t_start=0.0, t_stop=kit.STOP)
-            for a, b in zip(kit._validate_signal(**kw), validate_signal(**kw)):
-                assert np.array_equal(a, b)
-
-
 def test_the_readme_commands_reproduce_the_references(fmus, models, tmp_path):
     """Each ReadMe.md's fmpy command line, run in a copy of its folder with the FMU
     beside it: no FMU warning, the reference again (byte for byte on a CPU with FMA)."""
@@ -201,7 +178,6 @@ def test_the_readme_commands_reproduce_the_references(fmus, models, tmp_path):
         assert "python3 python/wheelflat_kit.py check\n" in text
 
 
-@pytest.mark.skipif(not has_scipy(), reason="fmpy's validate_result needs scipy")
 def test_the_readme_python_check_passes(fmus, tmp_path):
     copy = in_layout_copy(tmp_path, fmus)
     f = kit.files(copy, "TrackContact")
