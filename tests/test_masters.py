@@ -89,7 +89,8 @@ def _libcosim(spec, path, n):
         ex = CosimExecution.from_ssp_file(path)
     else:
         ex = CosimExecution.from_ssp_file(path, step_ns)
-    track = ex.slave_index_from_instance_name("track")
+    # Every component is named after its FMU (OMSimulator needs it: build_fmus' systems.rs).
+    track = ex.slave_index_from_instance_name("TrackContact")
     vr = {v.name.decode(): v.reference for v in ex.slave_variables(track)}
     last = CosimObserver.create_last_value()
     ex.add_observer(last)
@@ -130,13 +131,13 @@ def _ecos(spec, path, n):
             t = sim.get_time()
             for f in forces:
                 early[f][0].append(t)
-                early[f][1].append(sim.get_real("track::" + f))
+                early[f][1].append(sim.get_real("TrackContact::" + f))
             if k < done:
                 sim.step(1)
     # sim.step(n), not step_until: ecos sums its clock and can stop one step short.
     sim.step(steps - done)
     names = wheel_names(n, "max_force") + ["position"]
-    vals = [sim.get_real("track::" + x) for x in names]
+    vals = [sim.get_real("TrackContact::" + x) for x in names]
     t = sim.get_time()
     sim.terminate()
     sim.free()
@@ -387,7 +388,7 @@ def test_the_shipped_contact_pair_runs_in_fmpy_simulate_ssp(capfd):
     datum = [x for x in out.splitlines() if "inputs.datum = first_step" in x]
     assert len(datum) == 1, out[-3000:]
     assert "wheel.left.z = 0.0000 mm at the first step, -1.5337 mm now (static -1.5336 mm)" in datum[0], datum
-    forces = ["track.contact.left.force", "track.contact.right.force"]
+    forces = ["TrackContact.contact.left.force", "TrackContact.contact.right.force"]
     # The track held its static state through the first step and the datum's new take.
     static = r[forces[0]][0]
     assert abs(r[forces[0]][1] / static - 1) < 0.005, r[forces[0]][:3]
@@ -424,3 +425,32 @@ def test_the_shipped_contact_pair_runs_in_fmpy_simulate_ssp(capfd):
         s.terminate()
         s.freeInstance()
     assert np.allclose(ssp_peaks, peaks, rtol=5e-4), (ssp_peaks, peaks)
+
+
+def test_the_quick_start_runs_a_bogie_at_the_axle_boxes_in_both_masters():
+    """(g) python/quickstart/bogie_in_masters.py: the shipped roll-plane axle-box SSP, as
+    it is, in libcosim and ecos against CoupledSystem on the SSP's own parameters. Its
+    figures (kN to 0.1 kN) are this file's: CoupledSystem's the monolithic's here, both
+    masters alike and within 1 %; every line but the last, `wall time:`, deterministic."""
+    script = os.path.join("python", "quickstart", "bogie_in_masters.py")
+    tmp = tempfile.mkdtemp(prefix="wheelflat_quickstart_")
+    try:
+        runs = [subprocess.run([sys.executable, script], cwd=ROOT, capture_output=True, text=True, timeout=300,
+                               env=dict(os.environ, TMPDIR=tmp)) for _ in range(2)]
+        assert os.listdir(tmp) == [], "the script leaves ecos' unpacked SSP behind"
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    for p in runs:
+        assert p.returncode == 0, p.stdout + p.stderr[-3000:]
+    lines = runs[0].stdout.splitlines()
+    assert lines[-1].startswith("wall time: ") and lines[:-1] == runs[1].stdout.splitlines()[:-1], lines
+    peaks = {}
+    for line in lines:
+        m = re.match(r"  (\w+) +left +([\d.]+), right +([\d.]+)", line)
+        if m:
+            peaks[m.group(1)] = [float(m.group(2)), float(m.group(3))]
+    assert list(peaks) == ["CoupledSystem", "libcosim", "ecos"], lines
+    mono = monolithic("RollPlaneVehicle")["peaks"]
+    assert peaks["CoupledSystem"] == [round(x / 1e3, 1) for x in mono], (peaks, mono)
+    assert peaks["libcosim"] == peaks["ecos"], peaks
+    assert all(abs(x / q - 1) < 0.01 for x, q in zip(peaks["libcosim"], peaks["CoupledSystem"])), peaks

@@ -6,9 +6,17 @@
 //!   under `resources/`, the parameters as an inline `ssv:ParameterSet` named
 //!   `wheelflat`, the base step as the `osp:FixedStepAlgorithm` annotation and a
 //!   `DefaultExperiment` to [`STOP_TIME`] (libcosim and ecos both read it: the literal
-//!   prefixes `ssd:`, `ssc:`, `ssv:`, `osp:` and `version="1.0"` are what both accept);
+//!   prefixes `ssd:`, `ssc:`, `ssv:`, `osp:` and `version="1.0"` are what both accept),
+//!   and the same base step as OMSimulator's fixed-step master in the root system's
+//!   `org.openmodelica` annotation (OMSimulator takes the system's type from it alone
+//!   and refuses an SSP without it);
 //! - an OSP system structure, `<system>/OspSystemStructure.xml` (libcosim), its sources
 //!   `../../<modelIdentifier>.fmu`, relative to the file's folder.
+//!
+//! Every component (OSP simulator) is named after its FMU's `modelIdentifier`
+//! (`TrackContact`, `RollPlaneVehicle`, ...): OMSimulator reads a parameter's leading
+//! `<component>.` as the component, so TrackContact's `track.*` parameters on a component
+//! named `track` would be lost there.
 //!
 //! The connections come from the variable table, never by hand: at interface X every
 //! input of either FMU that is used when `interface` = X (`VarSpec::used_when`) and
@@ -33,10 +41,9 @@ pub const STOP_TIME: f64 = 0.6;
 pub const AXLE_BOX_STEP: f64 = 1e-3;
 /// `track.window.ahead` and `track.window.behind` (m): the endless track, converged.
 pub const WINDOW: f64 = 20.0;
-/// SSP component and OSP simulator names.
-pub const TRACK: &str = "track";
-/// SSP component and OSP simulator name of the vehicle.
-pub const VEHICLE: &str = "vehicle";
+/// The `xmlns:oms` namespace OMSimulator writes in the SSDs it exports.
+const OMS_NAMESPACE: &str =
+    "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd";
 
 /// Where the vehicle meets the track: the value of the FMUs' `interface` parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,7 +78,8 @@ pub enum Value {
     Integer(i32),
 }
 
-/// One connection: `from` (component, output) feeds `to` (component, input).
+/// One connection: `from` (component, output) feeds `to` (component, input); a
+/// component is named after its FMU's `modelIdentifier`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Connection {
     /// Source component name.
@@ -276,8 +284,10 @@ pub fn system(vehicle: &str, interface: Interface) -> System {
         vehicle.model_identifier,
         wheelsets(track)
     );
-    let mut connections = feeds((VEHICLE, vehicle), (TRACK, track), interface, n);
-    connections.extend(feeds((TRACK, track), (VEHICLE, vehicle), interface, n));
+    // Each component is named after its FMU.
+    let (t, v) = (track.model_identifier, vehicle.model_identifier);
+    let mut connections = feeds((v, vehicle), (t, track), interface, n);
+    connections.extend(feeds((t, track), (v, vehicle), interface, n));
     let speed = spec(track, "speed").start;
     let mut track_values = vec![
         value(track, "speed", speed),
@@ -364,12 +374,13 @@ fn description(s: &System) -> String {
 }
 
 impl System {
-    fn component(&self, name: &str) -> (&'static FmuTable, &[(&'static str, Value)]) {
-        if name == TRACK {
-            (self.track, &self.track_values)
-        } else {
-            (self.vehicle, &self.vehicle_values)
-        }
+    /// The two components, TrackContact first: each FMU (whose `modelIdentifier` names
+    /// its component) with its values.
+    pub fn components(&self) -> [(&'static FmuTable, &[(&'static str, Value)]); 2] {
+        [
+            (self.track, &self.track_values),
+            (self.vehicle, &self.vehicle_values),
+        ]
     }
 
     /// `SystemStructure.ssd`.
@@ -383,19 +394,20 @@ impl System {
     xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
     xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"
     xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations"
+    xmlns:oms="{oms}"
     name="{name}" version="1.0">
   <ssd:System name="{name}" description="{desc}">
     <ssd:Elements>
 "#,
             name = self.name,
-            desc = description(self)
+            desc = description(self),
+            oms = OMS_NAMESPACE
         );
-        for comp in [TRACK, VEHICLE] {
-            let (t, values) = self.component(comp);
+        for (t, values) in self.components() {
+            let comp = t.model_identifier;
             let _ = writeln!(
                 x,
-                r#"      <ssd:Component name="{comp}" source="resources/{}.fmu">"#,
-                t.model_identifier
+                r#"      <ssd:Component name="{comp}" source="resources/{comp}.fmu">"#
             );
             x.push_str("        <ssd:Connectors>\n");
             for c in &self.connections {
@@ -448,9 +460,20 @@ impl System {
                 c.from, c.output, c.to, c.input
             );
         }
+        // OMSimulator's own annotation of the root system, as it exports one: its
+        // fixed-step master (a weakly coupled system) at the same base step.
         let _ = write!(
             x,
             r#"    </ssd:Connections>
+    <ssd:Annotations>
+      <ssc:Annotation type="org.openmodelica">
+        <oms:Annotations>
+          <oms:SimulationInformation>
+            <oms:FixedStepMaster description="oms-ma" stepSize="{step}" absoluteTolerance="0.0001" relativeTolerance="0.0001"/>
+          </oms:SimulationInformation>
+        </oms:Annotations>
+      </ssc:Annotation>
+    </ssd:Annotations>
   </ssd:System>
   <ssd:DefaultExperiment startTime="0.0" stopTime="{stop}">
     <ssd:Annotations>
@@ -486,12 +509,11 @@ impl System {
             desc = description(self),
             step = num(self.step)
         );
-        for comp in [TRACK, VEHICLE] {
-            let (t, values) = self.component(comp);
+        for (t, values) in self.components() {
+            let comp = t.model_identifier;
             let _ = writeln!(
                 x,
-                r#"    <Simulator name="{comp}" source="{fmu_dir}/{}.fmu">"#,
-                t.model_identifier
+                r#"    <Simulator name="{comp}" source="{fmu_dir}/{comp}.fmu">"#
             );
             x.push_str("      <InitialValues>\n");
             for (name, v) in values {

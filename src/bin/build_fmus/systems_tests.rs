@@ -1,4 +1,5 @@
-//! Tests of the shipped system files: every input fed, the steps and parameter sets.
+//! Tests of the shipped system files: every input fed, the steps and parameter sets,
+//! the components' names and OMSimulator's annotation.
 
 use super::*;
 
@@ -14,7 +15,7 @@ fn inputs(s: &System, to: &str) -> Vec<(&'static str, &'static str)> {
 fn connections_follow_the_table() {
     let s = system("RollPlaneVehicle", Interface::Contact);
     assert_eq!(
-        inputs(&s, TRACK),
+        inputs(&s, "TrackContact"),
         [
             ("wheel.left.z", "wheel.left.z"),
             ("wheel.right.z", "wheel.right.z"),
@@ -22,21 +23,21 @@ fn connections_follow_the_table() {
         ]
     );
     assert_eq!(
-        inputs(&s, VEHICLE),
+        inputs(&s, "RollPlaneVehicle"),
         [
             ("contact.left.force", "contact.left.force"),
             ("contact.right.force", "contact.right.force")
         ]
     );
     let s = system("HalfCarBogie", Interface::AxleBox);
-    let track = inputs(&s, TRACK);
+    let track = inputs(&s, "TrackContact");
     assert_eq!(track.len(), 8, "{track:?}");
     assert!(track.iter().all(|(o, i)| o == i && wheelset_of(i) <= 2));
     assert!(track.contains(&(
         "wheelset[2].sideframe.right.v",
         "wheelset[2].sideframe.right.v"
     )));
-    let vehicle = inputs(&s, VEHICLE);
+    let vehicle = inputs(&s, "HalfCarBogie");
     assert_eq!(vehicle.len(), 4, "{vehicle:?}");
     assert!(vehicle.contains(&(
         "wheelset[2].primary.left.force",
@@ -61,8 +62,8 @@ fn bogie_parameters_and_track_step() {
     assert_eq!(get("interface"), Some(Value::Integer(1)));
     // 0.9 of the critical step of the default track, about 14.4 us.
     assert!(s.step > 1.0e-5 && s.step < 2.0e-5, "{}", s.step);
-    assert_eq!(inputs(&s, TRACK).len(), 6);
-    assert_eq!(inputs(&s, VEHICLE).len(), 4);
+    assert_eq!(inputs(&s, "TrackContact").len(), 6);
+    assert_eq!(inputs(&s, "HalfCarBogie").len(), 4);
 }
 
 #[test]
@@ -75,4 +76,113 @@ fn axle_box_force_is_fed_by_the_primary_force() {
     assert_eq!(source_name("wheel.left.z"), "wheel.left.z");
     assert_eq!(wheelset_of("wheelset[3].wheel.left.z"), 3);
     assert_eq!(wheelset_of("wheel.left.z"), 1);
+}
+
+/// The text of every `attr="..."` of `xml`, in order.
+fn attributes<'a>(xml: &'a str, attr: &str) -> Vec<&'a str> {
+    let key = format!(r#" {attr}=""#);
+    xml.match_indices(&key)
+        .map(|(i, _)| {
+            let rest = &xml[i + key.len()..];
+            &rest[..rest.find('"').unwrap()]
+        })
+        .collect()
+}
+
+#[test]
+fn every_component_is_named_after_its_fmu() {
+    // OMSimulator reads a parameter's leading `<component>.` as the component: a
+    // component named `track` would lose TrackContact's `track.window.ahead`.
+    for s in systems() {
+        let (track, vehicle) = (s.track.model_identifier, s.vehicle.model_identifier);
+        assert!(
+            s.connections
+                .iter()
+                .all(|c| [c.from, c.to] == [track, vehicle] || [c.from, c.to] == [vehicle, track]),
+            "{}: {:?}",
+            s.name,
+            s.connections
+        );
+        let ssd = s.ssd();
+        assert_eq!(
+            ssd.matches("<ssd:Component ").count(),
+            2,
+            "{}: {ssd}",
+            s.name
+        );
+        for id in [track, vehicle] {
+            assert!(
+                ssd.contains(&format!(
+                    r#"<ssd:Component name="{id}" source="resources/{id}.fmu">"#
+                )),
+                "{}: {ssd}",
+                s.name
+            );
+        }
+        for e in attributes(&ssd, "startElement")
+            .into_iter()
+            .chain(attributes(&ssd, "endElement"))
+        {
+            assert!(e == track || e == vehicle, "{}: element {e}", s.name);
+        }
+        let osp = s.osp("../..");
+        let simulators = attributes(&osp, "simulator");
+        assert_eq!(simulators.len(), 2 * s.connections.len());
+        assert!(simulators.iter().all(|e| *e == track || *e == vehicle));
+        for id in [track, vehicle] {
+            assert!(
+                osp.contains(&format!(
+                    r#"<Simulator name="{id}" source="../../{id}.fmu">"#
+                )),
+                "{}: {osp}",
+                s.name
+            );
+        }
+        // No parameter of a component begins with that component's name.
+        for (t, values) in s.components() {
+            let prefix = format!("{}.", t.model_identifier);
+            assert!(values.iter().all(|(n, _)| !n.starts_with(&prefix)));
+        }
+    }
+}
+
+#[test]
+fn the_root_system_carries_omsimulators_fixed_step_master() {
+    // OMSimulator (2.1) takes a system's type only from its own annotation of the root
+    // system (without it: "[NewSystem] internal error"); a fixed-step master at the
+    // shipped base step, written as OMSimulator writes it, the oms prefix declared.
+    for s in systems() {
+        let ssd = s.ssd();
+        assert!(ssd.contains(&format!(r#"xmlns:oms="{OMS_NAMESPACE}""#)));
+        let master = format!(
+            r#"
+    <ssd:Annotations>
+      <ssc:Annotation type="org.openmodelica">
+        <oms:Annotations>
+          <oms:SimulationInformation>
+            <oms:FixedStepMaster description="oms-ma" stepSize="{}" absoluteTolerance="0.0001" relativeTolerance="0.0001"/>
+          </oms:SimulationInformation>
+        </oms:Annotations>
+      </ssc:Annotation>
+    </ssd:Annotations>
+  </ssd:System>
+"#,
+            num(s.step)
+        );
+        // The root system's last child, after its connections.
+        let at = ssd
+            .find(&master)
+            .unwrap_or_else(|| panic!("{}: {ssd}", s.name));
+        assert!(ssd[..at].ends_with("</ssd:Connections>"), "{}", s.name);
+        assert_eq!(ssd.matches("<ssd:System ").count(), 1);
+        assert_eq!(ssd.matches("</ssd:System>").count(), 1);
+        // The same step as the OSP annotation libcosim reads.
+        assert_eq!(
+            attributes(&ssd, "stepSize"),
+            attributes(&ssd, "baseStepSize"),
+            "{}",
+            s.name
+        );
+        assert_eq!(attributes(&ssd, "stepSize")[0].parse::<f64>(), Ok(s.step));
+    }
 }
