@@ -668,8 +668,9 @@ def compute(sources, log=print):
     return figures
 
 
-def check(only=None, log=print):
-    """The stale figures and plots, as messages (empty when all are current)."""
+def check(only=None, log=print, transcripts_too=True):
+    """The stale figures, plots and transcripts, as messages (empty when all are
+    current). tests/test_figures.py leaves the transcripts to tests/test_docs.py."""
     global CHECKING
     CHECKING, STALE[:] = True, []
     texts = {p: open(os.path.join(ROOT, p)).read() for p in pages()}
@@ -678,12 +679,29 @@ def check(only=None, log=print):
     for page, text in texts.items():
         for kind, name, committed, _ in markers(text):
             if name in figures and not same_figure(committed, figures[name]):
-                stale.append(f"{page}: {name} reads {committed.strip()!r}; the current build gives "
-                             f"{figures[name].strip()!r}")
+                stale.append(f"{page}: {name} {differs(committed, figures[name])}")
             elif name not in figures and (only is None or name.split(".")[0] in only):
                 stale.append(f"{page}: {name}: its source gives no such figure")
+        if transcripts_too and only is None:
+            for cmd, shown, (first, _) in transcripts(text):
+                try:
+                    diff = same_transcript(shown, run_command(cmd))
+                except (RuntimeError, subprocess.TimeoutExpired) as e:
+                    diff = str(e)
+                if diff is not None:
+                    stale.append(f"{page}:{first}: `$ {cmd}`: {diff}")
     CHECKING = False
     return stale
+
+
+def differs(committed, current):
+    """How a committed figure differs from the build's: the whole figure, or a table's
+    first row that differs."""
+    a, b = committed.strip().split("\n"), current.strip().split("\n")
+    if len(a) == len(b) > 1:
+        row = next(i for i, (x, y) in enumerate(zip(a, b)) if not same_figure(x, y))
+        return f"row {row + 1} reads {a[row]!r}; the current build gives {b[row]!r}"
+    return f"reads {committed.strip()!r}; the current build gives {current.strip()!r}"
 
 
 def write(only=None, transcripts_too=True, log=print):
