@@ -76,7 +76,9 @@ def main():
     fig.tight_layout()
     png = os.path.join(args.out, "axle_box_coupling.png")
     fig.savefig(png, dpi=120)
-    print(f"wrote {csv} and {png}")
+    # Relative to the working folder when inside it (as couple.py), else whole.
+    shown = [f if os.path.relpath(f).startswith("..") else os.path.relpath(f) for f in (csv, png)]
+    print(f"wrote {shown[0]} and {shown[1]}")
     print(f"wall time: {t2 - t0:.1f} s")
 
 

@@ -279,6 +279,13 @@ def primary_stiffness_tables(study, ok):
             "contact_rise": f"{100 * min(rises):.0f} to {100 * max(rises):.0f} %"}
 
 
+def source_quickstart():
+    """The quick starts' lengths (lines), as quickstart.md quotes them."""
+    folder = os.path.join(ROOT, "python", "quickstart")
+    return {f"quickstart.lines.{name[:-3]}": str(sum(1 for _ in open(os.path.join(folder, name))))
+            for name in sorted(os.listdir(folder)) if name.endswith(".py")}
+
+
 def source_regression():
     """The references of quick start (d), python/quickstart/test_regression.py: each of
     its cases through CoupledSystem, as the test runs it."""
@@ -558,6 +565,7 @@ def source_axle_box_masters():
 
 SOURCES = {
     "regression": source_regression,
+    "quickstart": source_quickstart,
     "comm_step": source_comm_step,
     "derivatives": source_derivatives,
     "wagon": source_wagon,
@@ -660,10 +668,14 @@ def figures_wanted(texts, only=None):
 
 
 def compute(sources, log=print):
+    import contextlib
+    import io
     figures = {}
     for s in sources:
         t0 = time.perf_counter()
-        figures.update(SOURCES[s]())
+        # The FMUs' warnings, which fmpy prints, are part of what the figures show, not news.
+        with contextlib.redirect_stdout(io.StringIO()):
+            figures.update(SOURCES[s]())
         log(f"{s}: {time.perf_counter() - t0:.1f} s")
     return figures
 
@@ -719,6 +731,9 @@ def write(only=None, transcripts_too=True, log=print):
                 t0 = time.perf_counter()
                 try:
                     output = run_command(cmd)
+                    if ROOT in output:
+                        raise RuntimeError(f"`{cmd}` prints this checkout's path {ROOT}: print paths "
+                                           "relative to the repository, as couple.py does")
                     # A transcript that shows what the command prints (times apart) stays as it is.
                     if not shown or same_transcript(shown, output) is not None:
                         lines[a:b] = printed(output)

@@ -14,7 +14,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
-FMU, STOP = "fmu/TrackContact.fmu", 0.3  # s: one impact of the default flat
+FMU, STOP = "fmu/TrackContact.fmu", 0.3  # s: two impacts of the default flat (at 39 and 192 ms)
 SPEED, RADIUS = 70 / 3.6, 0.475          # m/s, m: the speed and the wheel radius
 # Per wheel: half of table 4.4's 1,120 kg wheelset and half the 20,830 kg above it.
 M_WHEEL, M_SPRUNG = 560.0, 10415.0       # kg

@@ -2,7 +2,7 @@
 
     .venv/bin/python -m pytest -q python/quickstart/test_regression.py
 
-Each case runs CoupledSystem (the whole model in one FMU) for 0.3 s, one impact of the
+Each case runs CoupledSystem (the whole model in one FMU) for 0.3 s, two impacts of the
 flat on the left wheel, and asserts the peak contact force of each wheel against the
 reference of this build (REFERENCE, in N). Assert TrackContact's running maxima
 `contact.*.max_force` at the stop time, never the largest sample of `contact.*.force`:
