@@ -239,7 +239,10 @@ def readme(model, md, words, driven, ref):
         f"the inputs of `{model}_in.csv`: {words}."
         + (" One communication step is one track step (`solver.step`, 14.41 us by default, shortened to fit "
            "the step): TrackContact warns (`fmi2Warning`) of a master that holds the wheel heights over "
-           "more than 1.5 track steps." if model == "TrackContact" else "")
+           "more than 1.5 track steps. fmpy records the outputs after each step, before it sets the next "
+           "heights: `contact.*.force` there is the force under the heights held over the step, while "
+           "`contact.*.max_force` also counts the force that each newly set height gives at its point (the "
+           "direct feedthrough), which at the impact is about 2 % higher." if model == "TrackContact" else "")
         + " The inputs are interpolated linearly in time, and a time given twice is a step.", "",
         "| input | unit | in the case |", "|---|---|---|",
     ]
