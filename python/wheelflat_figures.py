@@ -13,7 +13,9 @@ target/release/ (built first if missing):
 
 1. Figures in the prose, between markers ``<!--fig NAME-->301.92 kN<!--/fig-->``, and
    generated blocks (tables) between ``<!--generated NAME-->`` and ``<!--/generated-->``,
-   in README.md, docs/guide/*.md and docs/STUDIES.md. NAME's first word names its
+   in README.md, docs/guide/*.md, docs/STUDIES.md and python/quickstart/test_regression.py
+   (in its comments). A marker left open, nested or mistyped stops the command, naming
+   the page and line, before anything runs. NAME's first word names its
    source in SOURCES (``pair.left`` comes from ``pair``).
 2. Transcripts: each ```console block of those pages whose first line is ``$ COMMAND``
    shows below it what COMMAND prints (cargo's status lines left out). A line that
@@ -46,14 +48,39 @@ ROOT = wf.ROOT
 # The pages, with docs/guide/*.md after the first; a Python file quotes figures in its comments.
 PAGES = ["README.md", "docs/STUDIES.md", "python/quickstart/test_regression.py"]
 VENV_BIN = os.path.join(ROOT, ".venv", "bin")
-MARKER = re.compile(r"<!--(fig|generated) ([\w.\-\[\]]+)-->(.*?)<!--/\1-->", re.S)
-NUMBER = re.compile(r"[+-]?\d[\d,]*(?:\.\d+)?")
+NUMBER = re.compile(r"[+-]?\d[\d,]*(?:\.\d+)?(?:[eE][+-]?\d+)?")
+# A marker's start or end, as written; anything that looks like one but is not is refused.
+TOKEN = re.compile(r"<!--(/?)(fig|generated)(?: ([\w.\-\[\]]+))?-->")
+LOOSE = re.compile(r"<!--\s*/?\s*(fig|generated)\b[^>]*-->")
 # A time as pytest and cargo print it, "0.53s": not compared.
 SECONDS = re.compile(r"\b\d+(?:\.\d+)?s\b")
 CARGO_STATUS = re.compile(r"^\s+(Compiling|Finished|Running|Blocking|Updating|Downloaded|Downloading|Locking)\b")
 STUDY_PLOTS = os.path.join(ROOT, "docs", "studies")
 # The digest of a study's results, kept in each of its PNG plots (a tEXt chunk).
 DIGEST_KEY = "wheelflat-results"
+
+
+def read_pages():
+    """Each page's text (UTF-8, its line ends as \\n; CRLF pages are written back so),
+    its markers checked first: a bad marker stops the command before anything runs."""
+    texts, crlf = {}, set()
+    for p in pages():
+        with open(os.path.join(ROOT, p), encoding="utf-8", newline="") as fh:
+            text = fh.read()
+        if "\r\n" in text:
+            crlf.add(p)
+            text = text.replace("\r\n", "\n")
+        markers(text, p)
+        transcripts_of(text, p)
+        texts[p] = text
+    return texts, crlf
+
+
+def transcripts_of(text, page):
+    try:
+        return transcripts(text)
+    except MarkerError as e:
+        raise MarkerError(f"{page}:{str(e)[5:]}") from None
 
 
 def pages():
@@ -132,9 +159,14 @@ def study_table(study_file):
     sys.path.insert(0, os.path.join(ROOT, "python"))
     from wheelflat_study.spec import load_study
     from wheelflat_study.run import run_study
+    import shutil
     study = load_study(study_file)
     tmp = tempfile.mkdtemp(prefix="figures_")
-    table, _ = run_study(study, tmp, serial=True, progress=False, plots=True, log=lambda *a: None)
+    try:
+        table, _ = run_study(study, tmp, serial=True, progress=False, plots=True, log=lambda *a: None)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     return study, table, tmp
 
 
@@ -187,18 +219,29 @@ def wf_start(name):
 # The plots each study draws into docs/studies/ (its [[plot]] names).
 def write_plots(study, ok, tmp):
     """Puts the study's PNG plots into docs/studies/ (write mode) or checks that the
-    committed ones carry the digest of these results (check mode)."""
-    from PIL import Image, PngImagePlugin
+    committed ones carry the digest of these results and of their own [[plot]] entry,
+    which says what each draws (check mode)."""
+    import json
+    from PIL import Image, PngImagePlugin, UnidentifiedImageError
     # The results, not the times they took.
     cols = [c for c in ok.columns if ok[c].dtype.kind == "f" and not c.endswith("wall_s")]
-    d = digest(ok, sorted(cols))
+    results = digest(ok, sorted(cols))
     for p in study.plots:
         name = p.get("name")
+        d = results + hashlib.sha256(json.dumps(p, sort_keys=True).encode()).hexdigest()[:8]
         committed = os.path.join(STUDY_PLOTS, f"{name}.png")
         if CHECKING:
-            have = Image.open(committed).text.get(DIGEST_KEY) if os.path.exists(committed) else None
+            where = f"docs/studies/{name}.png"
+            if not os.path.exists(committed):
+                STALE.append(f"{where}: missing: run python3 python/wheelflat_figures.py")
+                continue
+            try:
+                have = Image.open(committed).text.get(DIGEST_KEY)
+            except (UnidentifiedImageError, OSError) as e:
+                STALE.append(f"{where}: no PNG ({e}): run python3 python/wheelflat_figures.py")
+                continue
             if have != d:
-                STALE.append(f"docs/studies/{name}.png: drawn from other results (digest {have}, "
+                STALE.append(f"{where}: drawn from other results or another [[plot]] entry (digest {have}, "
                              f"the current build's {d}): run python3 python/wheelflat_figures.py")
             continue
         info = PngImagePlugin.PngInfo()
@@ -586,22 +629,70 @@ STALE = []
 
 # ---------------------------------------------------------------------------- markers
 
-def markers(text):
-    """(kind, name, committed text, span) of each marker of a page."""
-    return [(m.group(1), m.group(2), m.group(3), m.span(3)) for m in MARKER.finditer(text)]
+class MarkerError(ValueError):
+    pass
+
+
+def markers(text, page="the page"):
+    """(kind, name, committed text, span) of each marker of a page. A marker left open,
+    closed by the other kind, nested, or written almost as one is refused (MarkerError,
+    naming the page and line), before anything is compared or written."""
+    line = lambda at: text.count("\n", 0, at) + 1
+    strict = {m.span() for m in TOKEN.finditer(text)}
+    for m in LOOSE.finditer(text):
+        if m.span() not in strict:
+            raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)} is no marker: "
+                              "<!--fig NAME-->...<!--/fig--> or <!--generated NAME-->...<!--/generated-->")
+    found, open_ = [], None
+    for m in TOKEN.finditer(text):
+        closing, kind, name = m.group(1) == "/", m.group(2), m.group(3)
+        if not closing and name is None:
+            raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)} names no figure")
+        if closing and name is not None:
+            raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)}: an end marker names nothing")
+        if not closing:
+            if open_ is not None:
+                raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)} inside {open_[0].group(0)} "
+                                  f"(line {line(open_[0].start())}), which is not closed")
+            open_ = (m, kind, name)
+        else:
+            if open_ is None:
+                raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)} closes no marker")
+            if kind != open_[1]:
+                raise MarkerError(f"{page}:{line(m.start())}: {m.group(0)} closes {open_[0].group(0)} "
+                                  f"(line {line(open_[0].start())}): it takes <!--/{open_[1]}-->")
+            found.append((kind, open_[2], text[open_[0].end():m.start()], (open_[0].end(), m.start())))
+            open_ = None
+    if open_ is not None:
+        raise MarkerError(f"{page}:{line(open_[0].start())}: {open_[0].group(0)} is never closed "
+                          f"(<!--/{open_[1]}-->)")
+    return found
+
+
+def rewrite(text, figures, page):
+    """The text with each marker's content replaced by its figure (markers checked first)."""
+    out, at = [], 0
+    for _, name, _, (a, b) in markers(text, page):
+        out.append(text[at:a])
+        out.append(figures[name])
+        at = b
+    return "".join(out) + text[at:]
 
 
 def same_figure(committed, current):
-    """Equal as printed, but for one unit in the last printed digit of a number."""
+    """Equal as printed, but for one unit in the last printed digit of a number (its
+    mantissa; the exponent and the digits printed must agree)."""
     if committed == current:
         return True
     a, b = NUMBER.findall(committed), NUMBER.findall(current)
     if len(a) != len(b) or NUMBER.sub("#", committed) != NUMBER.sub("#", current):
         return False
     for x, y in zip(a, b):
-        x, y = x.replace(",", ""), y.replace(",", "")
-        digits = len(x.split(".")[1]) if "." in x else 0
-        if ("." in y and len(y.split(".")[1]) != digits) or abs(float(x) - float(y)) > 1.01 * 10 ** -digits:
+        (mx, _, ex), (my, _, ey) = (v.replace(",", "").lower().partition("e") for v in (x, y))
+        digits = len(mx.split(".")[1]) if "." in mx else 0
+        if ex != ey or (len(my.split(".")[1]) if "." in my else 0) != digits:
+            return False
+        if abs(float(mx) - float(my)) > 1.01 * 10 ** -digits:
             return False
     return True
 
@@ -615,8 +706,10 @@ def transcripts(text):
     while i < len(lines):
         if lines[i].strip() == "```console":
             j = i + 1
-            while not lines[j].startswith("```"):
+            while j < len(lines) and not lines[j].startswith("```"):
                 j += 1
+            if j == len(lines):
+                raise MarkerError(f"line {i + 1}: a ```console block that is never closed")
             body = lines[i + 1:j]
             if body and body[0].startswith("$ ") and sum(ln.startswith("$ ") for ln in body) == 1:
                 out.append((body[0][2:].strip(), body[1:], (i + 2, j)))
@@ -626,8 +719,10 @@ def transcripts(text):
 
 
 def printed(output):
-    """What a transcript shows of a command's output: cargo's status lines left out."""
-    return [ln.rstrip() for ln in output.rstrip("\n").split("\n") if not CARGO_STATUS.match(ln)]
+    """What a transcript shows of a command's output: cargo's status lines left out
+    (nothing for an output of nothing)."""
+    lines = output.rstrip("\n").split("\n") if output.strip("\n") else []
+    return [ln.rstrip() for ln in lines if not CARGO_STATUS.match(ln)]
 
 
 def same_transcript(shown, output):
@@ -659,11 +754,11 @@ def run_command(cmd, timeout=600):
 # ---------------------------------------------------------------------------- the command
 
 def figures_wanted(texts, only=None):
-    names = {name for t in texts.values() for _, name, _, _ in markers(t)}
-    sources = {n.split(".")[0] for n in names} | {s for s in SOURCES if not s.startswith(("pair", "seed"))}
-    unknown = sorted(n for n in names if n.split(".")[0] not in SOURCES)
+    names = {(name, page) for page, t in texts.items() for _, name, _, _ in markers(t, page)}
+    sources = {n.split(".")[0] for n, _ in names} | {s for s in SOURCES if not s.startswith(("pair", "seed"))}
+    unknown = sorted(f"{page}: {n}" for n, page in names if n.split(".")[0] not in SOURCES)
     if unknown:
-        raise SystemExit(f"unknown figures (no source in SOURCES): {unknown}")
+        raise MarkerError(f"figures of no source (SOURCES: {', '.join(SOURCES)}): {'; '.join(unknown)}")
     return sorted(s for s in sources if only is None or s in only)
 
 
@@ -685,11 +780,11 @@ def check(only=None, log=print, transcripts_too=True):
     current). tests/test_figures.py leaves the transcripts to tests/test_docs.py."""
     global CHECKING
     CHECKING, STALE[:] = True, []
-    texts = {p: open(os.path.join(ROOT, p)).read() for p in pages()}
+    texts, _ = read_pages()
     figures = compute(figures_wanted(texts, only), log)
     stale = list(STALE)
     for page, text in texts.items():
-        for kind, name, committed, _ in markers(text):
+        for kind, name, committed, _ in markers(text, page):
             if name in figures and not same_figure(committed, figures[name]):
                 stale.append(f"{page}: {name} {differs(committed, figures[name])}")
             elif name not in figures and (only is None or name.split(".")[0] in only):
@@ -710,8 +805,8 @@ def differs(committed, current):
     """How a committed figure differs from the build's: the whole figure, or a table's
     first row that differs."""
     a, b = committed.strip().split("\n"), current.strip().split("\n")
-    if len(a) == len(b) > 1:
-        row = next(i for i, (x, y) in enumerate(zip(a, b)) if not same_figure(x, y))
+    row = next((i for i, (x, y) in enumerate(zip(a, b)) if not same_figure(x, y)), None)
+    if len(a) == len(b) > 1 and row is not None:
         return f"row {row + 1} reads {a[row]!r}; the current build gives {b[row]!r}"
     return f"reads {committed.strip()!r}; the current build gives {current.strip()!r}"
 
@@ -720,11 +815,13 @@ def write(only=None, transcripts_too=True, log=print):
     """Rewrites every figure, transcript, plot and the kit; the transcripts whose command
     failed (left as they were), as messages."""
     failed = []
-    texts = {p: open(os.path.join(ROOT, p)).read() for p in pages()}
+    texts, crlf = read_pages()
     figures = compute(figures_wanted(texts, only), log)
     for page, text in texts.items():
-        new = MARKER.sub(lambda m: f"<!--{m.group(1)} {m.group(2)}-->{figures.get(m.group(2), m.group(3))}"
-                                   f"<!--/{m.group(1)}-->", text)
+        missing = [n for _, n, _, _ in markers(text, page) if n not in figures and (only is None or n.split(".")[0] in only)]
+        if missing:
+            failed.append(f"{page}: its source gives no figure {', '.join(missing)}")
+        new = rewrite(text, {n: figures.get(n, c) for _, n, c, _ in markers(text, page)}, page)
         if transcripts_too and only is None:
             lines = new.split("\n")
             for cmd, shown, (a, b) in reversed(transcripts(new)):
@@ -734,6 +831,8 @@ def write(only=None, transcripts_too=True, log=print):
                     if ROOT in output:
                         raise RuntimeError(f"`{cmd}` prints this checkout's path {ROOT}: print paths "
                                            "relative to the repository, as couple.py does")
+                    if "```" in output:
+                        raise RuntimeError(f"`{cmd}` prints a code fence, which would end its block")
                     # A transcript that shows what the command prints (times apart) stays as it is.
                     if not shown or same_transcript(shown, output) is not None:
                         lines[a:b] = printed(output)
@@ -743,8 +842,8 @@ def write(only=None, transcripts_too=True, log=print):
                 log(f"{page}: $ {cmd}: {time.perf_counter() - t0:.1f} s")
             new = "\n".join(lines)
         if new != text:
-            with open(os.path.join(ROOT, page), "w") as fh:
-                fh.write(new)
+            with open(os.path.join(ROOT, page), "w", encoding="utf-8", newline="") as fh:
+                fh.write(new.replace("\n", "\r\n") if page in crlf else new)
             log(f"wrote {page}")
     kit = os.path.join(ROOT, "python", "wheelflat_kit.py")
     if os.path.exists(kit) and only is None:
@@ -758,11 +857,16 @@ def main(argv=None):
     ap.add_argument("--check", action="store_true", help="compare only; exit 1 naming each stale figure")
     ap.add_argument("--only", default=None, help=f"comma-separated sources of {', '.join(SOURCES)}")
     args = ap.parse_args(argv)
+    only = None if args.only is None else set(args.only.split(","))
+    if only is not None and (not only or only - set(SOURCES)):
+        ap.error(f"--only: unknown source {sorted(only - set(SOURCES)) or repr(args.only)}; known: {', '.join(SOURCES)}")
+    try:
+        read_pages()
+    except MarkerError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     wf.ensure_venv()
     wf.build_fmus()
-    only = None if args.only is None else set(args.only.split(","))
-    if only and only - set(SOURCES):
-        ap.error(f"--only: unknown source {sorted(only - set(SOURCES))}; known: {', '.join(SOURCES)}")
     if args.check:
         stale = check(only)
         for s in stale:

@@ -61,3 +61,42 @@ def test_a_transcript_compares_figures_not_times():
     assert "lines shown" in figures.same_transcript(shown, "peak 301.92 kN\n")
     # cargo's status lines are not part of a transcript
     assert figures.same_transcript(["x"], "   Compiling wheelflat v0.1.0\n    Finished `release`\nx\n") is None
+
+
+@pytest.mark.parametrize("text,said", [
+    ("a <!--fig pair.static-->107.66 kN and more", "is never closed"),
+    ("a <!--fig pair.static-->107.66 kN<!--/generated--> b", "it takes <!--/fig-->"),
+    ("<!--fig pair.static-->1 <!--fig pair.left-->2<!--/fig--> 3<!--/fig-->", "inside <!--fig pair.static-->"),
+    ("x<!--/fig--> y", "closes no marker"),
+    ("<!--fig pair.static -->107.66 kN<!--/fig-->", "is no marker"),
+    ("<!--fig-->107.66 kN<!--/fig-->", "names no figure"),
+])
+def test_a_bad_marker_is_refused_with_its_line(text, said):
+    # The breaker's findings: an unclosed, mismatched or nested marker made write mode
+    # swallow prose and exit 0.
+    with pytest.raises(figures.MarkerError) as e:
+        figures.markers("first line\n" + text, "page.md")
+    assert str(e.value).startswith("page.md:2: ") and said in str(e.value), str(e.value)
+
+
+def test_rewrite_replaces_only_the_markers_content():
+    text = "a <!--fig pair.left-->1 kN<!--/fig--> b\n<!--generated t-->\n| x |\n<!--/generated--> c"
+    new = figures.rewrite(text, {"pair.left": "2 kN", "t": "\n| y |\n"}, "p")
+    assert new == "a <!--fig pair.left-->2 kN<!--/fig--> b\n<!--generated t-->\n| y |\n<!--/generated--> c"
+
+
+@pytest.mark.parametrize("committed,current,same", [
+    ("255.8e3", "255.8e4", False),         # the exponent must agree
+    ("1.5e-5", "1.6e-5", True),
+    ("302.00 kN", "302 kN", False),        # the digits printed must agree, both ways
+    ("302 kN", "302.00 kN", False),
+])
+def test_the_stated_rounding_of_exponents_and_digits(committed, current, same):
+    assert figures.same_figure(committed, current) is same
+
+
+def test_a_command_that_prints_nothing_shows_nothing_and_a_blank_line_is_named():
+    assert figures.printed("") == [] and figures.same_transcript([], "") is None
+    assert "reads" in figures.differs("\n| a |\n\n", "\n| a |\n")
+    with pytest.raises(figures.MarkerError):
+        figures.transcripts("```console\n$ true\n")

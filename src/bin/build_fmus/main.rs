@@ -44,6 +44,25 @@ fn main() {
 /// exported functions stay), by binutils' `objcopy`; the symbols go to
 /// `out/debug/<name>.debug`, which the stripped library names (`.gnu_debuglink`) so a
 /// debugger finds them. Without `objcopy` the library is packed as it is, with a note.
+/// Writes `bytes` to `path` whole or not at all: into a file beside it, then renamed over
+/// it, so that a reader that has the old file open (an FMU being imported while the
+/// packer runs again) keeps reading the old one, and none ever reads half a file.
+pub fn write_whole(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut part = path.as_os_str().to_owned();
+    part.push(format!(".part{}", std::process::id()));
+    let part = PathBuf::from(part);
+    std::fs::write(&part, bytes)
+        .and_then(|()| std::fs::rename(&part, path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&part);
+        })
+}
+
+/// A zip archive in memory, for [`write_whole`].
+pub fn zip_in_memory() -> zip::ZipWriter<std::io::Cursor<Vec<u8>>> {
+    zip::ZipWriter::new(std::io::Cursor::new(Vec::new()))
+}
+
 fn stripped(lib: &Path, out: &Path) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     let name = lib
         .file_name()
@@ -127,16 +146,15 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
     let binary = stripped(&lib, &out)?;
     // A second argument: where to write the variables' documentation.
     if let Some(doc) = std::env::args().nth(2) {
-        std::fs::write(&doc, VARIABLES_MD)?;
+        write_whole(Path::new(&doc), VARIABLES_MD.as_bytes())?;
         println!("{doc} (from the variable table)");
     }
-    std::fs::write(out.join("fmus.json"), registry_json())?;
+    write_whole(&out.join("fmus.json"), registry_json().as_bytes())?;
     std::fs::create_dir_all(out.join("include"))?;
-    std::fs::write(out.join("include/wheelflat_fmi2.h"), C_HEADER)?;
+    write_whole(&out.join("include/wheelflat_fmi2.h"), C_HEADER.as_bytes())?;
     for t in FMUS {
         let path = out.join(format!("{}.fmu", t.model_identifier));
-        let file = std::fs::File::create(&path)?;
-        let mut z = zip::ZipWriter::new(file);
+        let mut z = zip_in_memory();
         let opts =
             SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         z.start_file("modelDescription.xml", opts)?;
@@ -157,7 +175,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             .ok_or_else(|| format!("no documentation page for {}", t.model_identifier))?;
         z.start_file("documentation/index.html", opts)?;
         z.write_all(page.as_bytes())?;
-        z.finish()?;
+        write_whole(&path, &z.finish()?.into_inner())?;
         println!("{} ({} {})", path.display(), t.model_identifier, t.guid);
     }
     systems::write(&out)?;
@@ -203,4 +221,30 @@ fn registry_json() -> String {
         fmus.join(", "),
         vehicles.join(",\n")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_whole;
+    use std::io::Read;
+
+    #[test]
+    fn a_file_written_again_is_replaced_whole_and_an_open_reader_keeps_the_old_one() {
+        // The breaker's finding: File::create truncated each FMU in place, and an importer
+        // reading it meanwhile got "File is not a zip file".
+        let dir =
+            std::env::temp_dir().join(format!("wheelflat_write_whole_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.fmu");
+        write_whole(&path, b"old contents").unwrap();
+        let mut reader = std::fs::File::open(&path).unwrap();
+        write_whole(&path, b"new").unwrap();
+        let mut old = String::new();
+        reader.read_to_string(&mut old).unwrap();
+        assert_eq!(old, "old contents");
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        // Nothing is left beside it.
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

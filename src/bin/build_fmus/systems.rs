@@ -549,7 +549,7 @@ pub fn write(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write(dir.join(".gitignore"), "# written by build_fmus\n*\n")?;
     for s in systems() {
         let ssp = dir.join(format!("{}.ssp", s.name));
-        let mut z = zip::ZipWriter::new(std::fs::File::create(&ssp)?);
+        let mut z = crate::zip_in_memory();
         let deflated =
             SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         z.start_file("SystemStructure.ssd", deflated)?;
@@ -563,11 +563,11 @@ pub fn write(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
             )?;
             z.write_all(&fmu)?;
         }
-        z.finish()?;
+        crate::write_whole(&ssp, &z.finish()?.into_inner())?;
         let osp_dir = dir.join(&s.name);
         std::fs::create_dir_all(&osp_dir)?;
         let osp = osp_dir.join("OspSystemStructure.xml");
-        std::fs::write(&osp, s.osp("../.."))?;
+        crate::write_whole(&osp, s.osp("../..").as_bytes())?;
         println!(
             "{} and {} ({} connections, step {} s)",
             ssp.display(),
