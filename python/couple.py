@@ -21,10 +21,15 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import wheelflat_fmus as wf  # noqa: E402
 
 
+# couple.py keeps every communication point in memory (about 70,000 a simulated second at
+# the track's step): a longer run belongs to CoupledSystem or a study.
+MAX_STOP = 60.0
+
+
 def main():
     wf.ensure_venv()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--stop", type=float, default=0.8, help="simulated time (s)")
+    ap.add_argument("--stop", type=float, default=0.8, help=f"simulated time (s), at most {MAX_STOP:g}")
     ap.add_argument("--step", type=float, default=None, help="communication step (s); default: solver.step")
     ap.add_argument("--speed", type=float, default=None, metavar="KMH",
                     help="forward speed (km/h); default: the FMUs' speed (70 km/h)")
@@ -34,6 +39,12 @@ def main():
                     help="depth of the left wheel's flat (mm; 0: from its length, (2.10)); default: the FMUs' (1.5 mm)")
     ap.add_argument("--out", default=os.path.join(wf.ROOT, "out"), help="output folder")
     args = ap.parse_args()
+    # What the FMUs cannot know: the run's length and the master's step.
+    import math
+    if not (math.isfinite(args.stop) and 0 < args.stop <= MAX_STOP):
+        ap.error(f"--stop {args.stop}: the simulated time must be finite, 0 < stop <= {MAX_STOP:g} s")
+    if args.step is not None and not (math.isfinite(args.step) and 0 < args.step <= args.stop):
+        ap.error(f"--step {args.step}: the communication step must be finite, 0 < step <= --stop ({args.stop:g} s)")
 
     t0 = time.perf_counter()
     paths = wf.build_fmus()
@@ -46,7 +57,12 @@ def main():
         track["flat.left[1].length"] = args.flat_length / 1e3
     if args.flat_depth is not None:
         track["flat.left[1].depth"] = args.flat_depth / 1e3
-    r = wf.run_pair(paths, args.stop, args.step, track_params=dict(track, **both), vehicle_params=both)
+    from fmpy.fmi1 import FMICallException
+    try:
+        r = wf.run_pair(paths, args.stop, args.step, track_params=dict(track, **both), vehicle_params=both)
+    except FMICallException as e:
+        # The FMU said why above ([ERROR] ...: the variable, its value and its range).
+        sys.exit(f"couple.py: the FMUs refused the case ({e}); their message above names the variable")
     t2 = time.perf_counter()
     case = wf.case_of(paths["TrackContact"], dict(track, **both))
 

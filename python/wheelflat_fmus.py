@@ -156,11 +156,16 @@ class Unit:
 
     def close(self, terminate=True):
         """Terminates (FMI 2.0 allows it after stepping only: pass terminate=False in
-        the other states) and frees the instance."""
+        the other states) and frees the instance. A refused fmi2Terminate (a run that
+        failed before it stepped) is passed over: the failure that stopped the run is
+        the one to report, and the instance is freed all the same."""
         import shutil
+        from fmpy.fmi1 import FMICallException
         try:
             if terminate:
                 self.fmu.terminate()
+        except FMICallException:
+            pass
         finally:
             self.fmu.freeInstance()
             if self.owns_dir:
@@ -171,6 +176,22 @@ WHEELS = ("wheel.left.z", "wheel.right.z", "wheel.rotation")
 FORCES = ("contact.left.force", "contact.right.force")
 TRACK_RECORD = ("contact.left.force", "contact.right.force", "contact.left.max_force", "contact.right.max_force",
                 "rail.left.z", "rail.right.z", "position")
+
+
+def close_all(*units):
+    """Closes every unit, each even when closing another fails; the first failure is
+    raised after every unit is freed and its folder removed. Called from a `finally`
+    while a failure unwinds (a parameter refused in initialization, say), it frees
+    without fmi2Terminate, which FMI 2.0 allows only after stepping."""
+    first = None
+    failing = sys.exc_info()[0] is not None
+    for u in units:
+        try:
+            u.close(terminate=not failing)
+        except Exception as e:  # noqa: BLE001 - raised below, once every unit is closed
+            first = first or e
+    if first is not None:
+        raise first
 
 
 def track_step(paths, track_params=None):
@@ -263,8 +284,7 @@ def run_pair(paths, stop_time, comm_step=None, track_params=None, vehicle_params
             t = (k + 1) * h
         return out
     finally:
-        track.close()
-        vehicle.close()
+        close_all(track, vehicle)
 
 
 def trailing(k, names):
@@ -328,9 +348,7 @@ def run_bogie(paths, stop_time, wheelsets=2, track_params=None, vehicle_params=N
             t = (step + 1) * h
         return out
     finally:
-        track.close()
-        for v in vehicles:
-            v.close()
+        close_all(track, *vehicles)
 
 
 FRAMES = ("sideframe.left.z", "sideframe.right.z", "sideframe.left.v", "sideframe.right.v")
@@ -369,8 +387,7 @@ def run_axle_box_pair(paths, stop_time, comm_step=1e-3, track_params=None, vehic
                 record.append([t + comm_step] + track.get(*FORCES, *PRIMARY))
         return track.get("contact.left.max_force", "contact.right.max_force")
     finally:
-        track.close()
-        vehicle.close()
+        close_all(track, vehicle)
 
 
 HEIGHTS = ("static_wheel_z.left", "static_wheel_z.right")
@@ -451,8 +468,7 @@ def run_carrier(paths, model, n, stop_time, track_params=None, vehicle_params=No
             t = (k + 1) * h
         return peak
     finally:
-        track.close()
-        vehicle.close()
+        close_all(track, vehicle)
 
 
 def run_half_car(paths, stop_time, track_params=None, bogie_params=None, record=None):
@@ -502,8 +518,7 @@ def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_param
         m = track.get(*every_wheelset(n, ("contact.left.max_force", "contact.right.max_force")))
         return [m[2 * i:2 * i + 2] for i in range(n)]
     finally:
-        track.close()
-        vehicle.close()
+        close_all(track, vehicle)
 
 
 def run_half_car_axle_box(paths, stop_time, comm_step=1e-3, track_params=None, bogie_params=None, record=None):

@@ -434,3 +434,21 @@ def test_every_command_answers_help(command):
     r = subprocess.run(command + ["--help"], cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "usage" in r.stdout.lower(), (r.returncode, r.stdout, r.stderr)
     assert not os.path.exists(os.path.join(ROOT, "--help"))
+
+
+@pytest.mark.parametrize("args,rc,said", [
+    (["--speed", "1000"], 1, "`speed` = 277.77777777777777 m/s is out of range"),
+    (["--flat-length", "-1"], 1, "flat.left[1].length"),
+    (["--stop", "-1"], 2, "--stop -1.0: the simulated time must be finite, 0 < stop <= 60 s"),
+    (["--stop", "nan"], 2, "--stop nan"),
+    (["--step", "0", "--stop", "0.01"], 2, "--step 0.0: the communication step must be finite"),
+])
+def test_couple_py_refuses_bad_values_naming_them_without_a_traceback(args, rc, said, tmp_path):
+    # The breaker's findings: tracebacks, a misleading fmi2Terminate error after the
+    # FMU's own message, and the vehicle's unpacked FMU left in $TMPDIR.
+    env = dict(os.environ, TMPDIR=str(tmp_path))
+    r = subprocess.run([VENV_BIN + "/python", "python/couple.py", "--out", str(tmp_path / "out")] + args, cwd=ROOT,
+                       env=env, capture_output=True, text=True, timeout=300)
+    out = r.stdout + r.stderr
+    assert r.returncode == rc and said in out and "Traceback" not in out and "fmi2Terminate" not in out, out
+    assert [p for p in os.listdir(tmp_path) if p != "out"] == []

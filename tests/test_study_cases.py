@@ -664,7 +664,8 @@ def test_every_csv_column_names_its_unit(tmp_path, runner):
     # Issue 40 (item 4): units in every CSV header ("peak.left [N]"); the Parquet tables
     # keep the plain names. A runner field or parameter without a known unit fails here.
     import pandas as pd
-    from wheelflat_study.tables import declared_units, unit_of
+    from wheelflat_study.run import runner_units
+    from wheelflat_study.tables import unit_of
     p = tmp_path / "units.toml"
     p.write_text('name = "units"\nduration = 0.3\nkeep = ["primary.left.force"]\n'
                  '[fixed]\n"track.window.ahead" = 8.0\n[sweep]\nspeed = { values = [70], unit = "km/h" }\n')
@@ -672,7 +673,8 @@ def test_every_csv_column_names_its_unit(tmp_path, runner):
     table, n = run_study(load_study(p), str(out), serial=True, runner_path=runner, progress=False, plots=False,
                          log=lambda *_: None)
     assert n == 1 and list(table["status"]) == ["ok"]
-    declared = declared_units()
+    declared = runner_units(runner)
+    assert declared["speed"] == "m/s" and declared["primary.left.force"] == "N"
     for name in ("results", "impacts"):
         plain = list(pd.read_parquet(out / f"{name}.parquet").columns)
         assert [c for c in plain if unit_of(c, declared) is None] == [], name

@@ -8,7 +8,7 @@ primary suspensions, the bogie gets the primary forces and returns its side fram
 motion, at the SSP's 1 ms step. Prints each master's peak contact forces and their
 difference from CoupledSystem's (the whole model in one FMU, on the SSP's parameters).
 """
-import os, re, shutil, tempfile, time, zipfile
+import os, re, shutil, sys, tempfile, time, zipfile
 import xml.etree.ElementTree as ET
 from ecospy import EcosLib, EcosSimulation
 from fmpy import read_model_description, simulate_fmu
@@ -16,6 +16,10 @@ from libcosimpy.CosimExecution import CosimExecution
 from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
 
+# The repository's paths (fmu/ as python3 python/couple.py builds it), from wherever it runs.
+os.chdir(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+if not os.path.exists("fmu/CoupledSystem.fmu"):
+    sys.exit("no fmu/CoupledSystem.fmu: build the FMUs first (python3 python/couple.py)")
 SSP = "fmu/systems/TrackContact_RollPlaneVehicle_axle_box.ssp"
 MAX = ["contact.left.max_force", "contact.right.max_force"]  # TrackContact's running maxima
 OUT = MAX + ["position"]  # and where the track is at the end
@@ -52,15 +56,17 @@ results["libcosim"] = last.last_real_values(track, [vr[x] for x in OUT])
 # ecos: the step from Python, the parameter set by name; it unpacks the SSP under $TMPDIR.
 os.environ["TMPDIR"] = tmp = tempfile.mkdtemp()
 EcosLib.set_log_level("warn")
-sim = EcosSimulation(ssp_path=SSP, step_size=step)
-sim.init(parameter_set="wheelflat")  # without the name no SSP parameter is applied
-sim.step(round(stop / step))
-results["ecos"] = [sim.get_real("TrackContact::" + x) for x in OUT]
+try:
+    sim = EcosSimulation(ssp_path=SSP, step_size=step)
+    sim.init(parameter_set="wheelflat")  # without the name no SSP parameter is applied
+    sim.step(round(stop / step))
+    results["ecos"] = [sim.get_real("TrackContact::" + x) for x in OUT]
+    sim.terminate()
+    sim.free()
+finally:
+    shutil.rmtree(tmp, ignore_errors=True)
 # ecos ignores every status: check that its track went as far as libcosim's.
 assert abs(results["ecos"].pop() - results["libcosim"].pop()) < 1e-9, "ecos: the track stopped"
-sim.terminate()
-sim.free()
-shutil.rmtree(tmp, ignore_errors=True)
 
 print("peak contact force (kN), leading wheelset, and the difference from CoupledSystem's:")
 for master, peaks in results.items():

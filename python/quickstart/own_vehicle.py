@@ -6,6 +6,7 @@ The vehicle: under each wheel a two-mass quarter vehicle, the wheel (half a whee
 and the sprung mass above it on the primary spring-damper, with gravity on both.
 Run from the repository root:  .venv/bin/python python/quickstart/own_vehicle.py
 """
+import os
 import shutil
 import sys
 import time
@@ -14,6 +15,10 @@ from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
+# The repository's paths (fmu/ as python3 python/couple.py builds it), from wherever it runs.
+os.chdir(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+if not os.path.exists("fmu/TrackContact.fmu"):
+    sys.exit("no fmu/TrackContact.fmu: build the FMUs first (python3 python/couple.py)")
 FMU, STOP = "fmu/TrackContact.fmu", 0.3  # s: two impacts of the default flat (at 39 and 192 ms)
 SPEED, RADIUS = 70 / 3.6, 0.475          # m/s, m: the speed and the wheel radius
 # Per wheel: half of table 4.4's 1,120 kg wheelset and half the 20,830 kg above it.

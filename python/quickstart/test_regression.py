@@ -9,10 +9,14 @@ reference of this build (REFERENCE, in N). Assert TrackContact's running maxima
 an output interval coarser than the track's step misses the impact's top
 (test_the_sampled_force_under_reads_the_peak shows by how much).
 """
+import os
+
 import pytest
 from fmpy import simulate_fmu
 
-FMU = "fmu/CoupledSystem.fmu"
+# fmu/ of this repository (python3 python/couple.py builds it), wherever pytest runs.
+FMU = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                   "fmu", "CoupledSystem.fmu")
 STOP = 0.3
 # A build's results agree with these to rounding; 0.1 % leaves room for another
 # machine's vector width and catches any change of the model (one grid step more
@@ -30,6 +34,7 @@ PEAKS = ["contact.left.max_force", "contact.right.max_force"]
 
 
 def run(speed, length, depth, **options):
+    assert os.path.exists(FMU), f"no {FMU}: build the FMUs first (python3 python/couple.py)"
     start = {"speed": speed / 3.6, "flat.left[1].length": length / 1e3, "flat.left[1].depth": depth / 1e3}
     return simulate_fmu(FMU, stop_time=STOP, start_values=start, output=PEAKS + ["contact.left.force"], **options)
 

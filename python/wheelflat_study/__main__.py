@@ -205,9 +205,10 @@ def check_variables(study, runner):
     try:
         listing = subprocess.run([runner, "--variables"], capture_output=True, text=True, check=True,
                                  timeout=60).stdout
-        known, outputs = {}, set()
+        known, outputs, units = {}, set(), {}
         for line in listing.splitlines():
-            name, ty, lo, hi = line.split("\t")
+            name, ty, lo, hi, unit = line.split("\t")
+            units[name] = unit
             if ty == "output":
                 outputs.add(name)
             else:

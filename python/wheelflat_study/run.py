@@ -241,6 +241,15 @@ def identity(runner_path=None):
     return known
 
 
+def runner_units(runner_path):
+    """Every variable's unit by name, as the case runner lists them (`--variables`: the
+    variable table's, the same as the FMUs' model descriptions)."""
+    import subprocess
+    listing = subprocess.run([runner_path, "--variables"], capture_output=True, text=True, check=True,
+                             timeout=60).stdout
+    return {f[0]: f[4] for f in (line.split("\t") for line in listing.splitlines()) if len(f) == 5}
+
+
 def run_chunk(chunk, runner_path=None):
     """Runs the cases of `chunk` (a list of (case id, runner line, time limit s); a line
     may be a list of pieces to join, Case.parts, which shares a table's content between
@@ -370,7 +379,7 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     if total > have:
         log(_ran(counts, total - have, elapsed))
     from .tables import write_tables
-    table = write_tables(study, out_dir, ident)
+    table = write_tables(study, out_dir, ident, units=runner_units(runner_path or default_runner()))
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:

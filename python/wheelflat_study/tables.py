@@ -37,8 +37,8 @@ def _flatten(res):
 
 # The unit of each column the case runner's result gives (src/bin/wheelflat_case.rs
 # documents its fields), by the column's name with the wheel or side left out; a
-# parameter's and a kept output's unit is the one CoupledSystem's model description
-# declares. Counts, fractions and text have none.
+# parameter's and a kept output's unit is the variable table's, as the runner lists it
+# (`wheelflat_case --variables`, run.runner_units). Counts, fractions and text have none.
 RESULT_UNITS = {"peak": "N", "impact_peak": "N", "first_impact_peak": "N", "bearing": "N", "contact_loss": "s",
                 "duration": "s", "runner_wall_s": "s", "wall_s": "s", "time": "s", "passage": "s"}
 NO_UNIT = {"impacts", "first_impact_span_position", "span_position", "k"}
@@ -58,17 +58,6 @@ def unit_of(name, declared):
     if head in RESULT_UNITS:
         return RESULT_UNITS[head]
     return "" if head in NO_UNIT else None
-
-
-def declared_units():
-    """Every variable's unit in CoupledSystem's model description, by name ({} without the FMU)."""
-    try:
-        from fmpy import read_model_description
-        from . import fmu_paths
-        md = read_model_description(fmu_paths()["CoupledSystem"])
-    except Exception:
-        return {}
-    return {v.name: v.unit or (v.declaredType.unit if v.declaredType else None) or "" for v in md.modelVariables}
 
 
 def csv_header(names, declared):
@@ -129,7 +118,7 @@ def _rows(case, rec):
     return row, impacts
 
 
-def write_tables(study, out_dir, ident=None):
+def write_tables(study, out_dir, ident=None, units=None):
     """Writes results.parquet/.csv and impacts.parquet/.csv from the records in
     `out_dir`'s cases.jsonl of the study's cases (in the study's order; cases without a
     record are left out) and of the model `ident`; returns the results
@@ -186,8 +175,7 @@ def write_tables(study, out_dir, ident=None):
             writers[name] = (pq.ParquetWriter(os.path.join(out_dir, f"{name}.parquet.part"), sch),
                              open(os.path.join(out_dir, f"{name}.csv.part"), "w", newline=""))
         batch = {"results": [], "impacts": []}
-        declared = declared_units()
-        header = {name: csv_header(names, declared) for name, (names, _) in tables.items()}
+        header = {name: csv_header(names, units or {}) for name, (names, _) in tables.items()}
 
         def flush(name):
             names, sch = tables[name]

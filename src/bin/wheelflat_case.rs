@@ -431,12 +431,12 @@ fn list_variables() {
                 VarType::String => "String",
                 _ => "Integer",
             };
-            let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}", v.name, v.min, v.max);
+            let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}\t{}", v.name, v.min, v.max, v.unit);
         }
     }
     for v in Kind::CoupledSystem.table().vars {
         if v.causality == Causality::Output && v.ty == VarType::Real {
-            let _ = writeln!(out, "{}\toutput\t-\t-", v.name);
+            let _ = writeln!(out, "{}\toutput\t-\t-\t{}", v.name, v.unit);
         }
     }
 }
@@ -480,7 +480,7 @@ fn main() {
                  Runs cases of CoupledSystem read from standard input, one per line of NAME=VALUE \
                  tokens with duration=S (and keep=OUT1,OUT2, case=ID), answering one JSON line \
                  each; --variables lists CoupledSystem's parameters, inputs and outputs with \
-                 their ranges. The sweep command (python -m wheelflat_study) drives it."
+                 their ranges and units (NAME TYPE MIN MAX UNIT, tab-separated). The sweep command (python -m wheelflat_study) drives it."
             );
             return;
         }
