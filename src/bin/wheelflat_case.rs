@@ -431,7 +431,11 @@ fn list_variables() {
                 VarType::String => "String",
                 _ => "Integer",
             };
-            let _ = writeln!(out, "{}\t{ty}\t{:?}\t{:?}\t{}", v.name, v.min, v.max, v.unit);
+            let _ = writeln!(
+                out,
+                "{}\t{ty}\t{:?}\t{:?}\t{}",
+                v.name, v.min, v.max, v.unit
+            );
         }
     }
     for v in Kind::CoupledSystem.table().vars {
