@@ -410,7 +410,7 @@ def check(fmu_dir=None, kit_dir=None, start_values=None, tolerance=TOLERANCE, be
     (fmpy.cross_check.validate_vendor_repo.validate_test_fmu: file sizes, the model
     description, the option file, the CSV files' names). Returns {model: [problems]},
     an empty list where it matches."""
-    from fmpy.util import read_csv, read_ref_opt_file
+    from fmpy.util import read_ref_opt_file
     fmu_dir = fmu_dir or wf.FMU_DIR
     kit_dir = kit_dir or default_kit()
     if models is None:
@@ -435,10 +435,16 @@ def check(fmu_dir=None, kit_dir=None, start_values=None, tolerance=TOLERANCE, be
         if beside and in_layout(kit_dir):
             from fmpy.cross_check.validate_vendor_repo import validate_test_fmu
             problems += [f"{model}: {p}" for p in validate_test_fmu(f["dir"])]
+        for key in ("opt", "in"):
+            if not os.path.isfile(f[key]):
+                problems.append(f"{model}: no {os.path.basename(f[key])} in {os.path.relpath(f['dir'])} (write the kit: "
+                                f"python3 python/wheelflat_kit.py write)")
+        if problems:
+            report[model] = problems
+            continue
         try:
             opt = read_ref_opt_file(f["opt"])
-            ref = read_csv(f["ref"])
-            inp = read_csv(f["in"]) if os.path.isfile(f["in"]) else None
+            ref, inp = (read_kit_csv(f[key]) for key in ("ref", "in"))
             md = _md(path)
             variables = {v.name: v for v in md.modelVariables}
             problems += [f"{model}: {n}: in {os.path.basename(f['in'])} but not an input of the FMU"
@@ -454,13 +460,33 @@ def check(fmu_dir=None, kit_dir=None, start_values=None, tolerance=TOLERANCE, be
                 continue
             res, messages = simulate(path, model, opt["StopTime"], opt["StepSize"], inp, list(ref.dtype.names[1:]),
                                      (start_values or {}).get(model), start=opt["StartTime"])
-        except Exception as e:  # a refusal of the FMU, a file that does not read
+        except KitFileError as e:
+            report[model] = problems + [f"{model}: {e}"]
+            continue
+        except Exception as e:  # a refusal of the FMU (its message logged above)
             report[model] = problems + [f"{model}: {type(e).__name__}: {e}"]
             continue
         problems += [f"{model}: the FMU logged {m}" for m in messages]
         units = {n: _unit(variables[n]) for n in ref.dtype.names[1:]}
         report[model] = problems + compare(model, res, ref, opt, tolerance, units)
     return report
+
+
+class KitFileError(ValueError):
+    pass
+
+
+def read_kit_csv(path):
+    """A kit's CSV file through fmpy's reader; one that does not read (cut mid-line,
+    empty, only a header) is refused naming the file."""
+    from fmpy.util import read_csv
+    try:
+        table = read_csv(path)
+    except Exception as e:
+        raise KitFileError(f"{os.path.relpath(path)} does not read as a CSV table ({type(e).__name__}: {e})") from None
+    if table.dtype.names is None or table.dtype.names[0] != "time" or len(table) < 2:
+        raise KitFileError(f"{os.path.relpath(path)}: a table of time and signals with two rows or more is needed")
+    return table
 
 
 def _parse_set(items):
@@ -475,6 +501,8 @@ def _parse_set(items):
             value = float(m.group(3))
         except ValueError:
             value = m.group(3)
+        if isinstance(value, float) and value != value:
+            raise SystemExit(f"--set {item}: {m.group(2)} = nan is no value")
         out.setdefault(m.group(1), {})[m.group(2)] = value
     return out
 
@@ -494,7 +522,13 @@ def main(argv=None):
     ap.add_argument("--set", action="append", metavar="MODEL:NAME=VALUE",
                     help="check: a parameter's start value for that model (repeatable)")
     args = ap.parse_args(argv)
+    if args.kit is not None and not args.kit.strip():
+        ap.error("--kit '': give the kit's folder, or leave the option out for the default")
     kit = os.path.abspath(args.kit) if args.kit else default_kit()
+    if args.command == "check" and not os.path.isdir(kit):
+        ap.error(f"--kit {args.kit}: no such folder (the default is {os.path.relpath(default_kit())})")
+    if not (args.tolerance == args.tolerance):
+        ap.error("--tolerance nan: give a number (0: the Cross-Check's band only)")
     missing = [m for m in wf.registry(args.fmus)["fmus"] if not os.path.isfile(os.path.join(args.fmus, m + ".fmu"))] \
         if os.path.isfile(os.path.join(args.fmus, "fmus.json")) else ["fmus.json"]
     if missing and not (args.command == "check" and args.beside):

@@ -209,8 +209,28 @@ def test_the_command_line(fmus, tmp_path):
     r = run("verify")
     assert r.returncode == 2 and "invalid choice" in r.stderr
     r = run("check", "--fmus", fmus, "--kit", str(tmp_path / "none"))
+    assert r.returncode == 2 and "none: no such folder" in r.stderr
+    (tmp_path / "empty").mkdir()
+    r = run("check", "--fmus", fmus, "--kit", str(tmp_path / "empty"))
     assert r.returncode == 1 and "TrackContact: no reference" in r.stdout
     r = run("check", "--fmus", str(tmp_path))
     assert r.returncode == 1 and "build the FMUs first" in r.stderr
     r = run("check", "--set", "Wagon=1")
     assert r.returncode == 1 and "expected MODEL:NAME=VALUE" in r.stderr
+
+
+def test_a_kit_file_that_does_not_read_is_named(fmus, tmp_path):
+    # The breaker's findings: a cut or empty reference ended in a bare ValueError or
+    # IndexError, and a missing input file was never named.
+    import shutil
+    copy = tmp_path / "kit"
+    shutil.copytree(KIT, copy)
+    f = kit.files(str(copy), "RollPlaneVehicle")
+    text = open(f["ref"]).read()
+    open(f["ref"], "w").write(text[: len(text) // 2 - 7])
+    os.remove(kit.files(str(copy), "Wagon")["in"])
+    open(kit.files(str(copy), "HalfCarBogie")["ref"], "w").write("")
+    report = kit.check(fmus, str(copy), models=["RollPlaneVehicle", "Wagon", "HalfCarBogie"])
+    assert "RollPlaneVehicle_ref.csv does not read as a CSV table" in report["RollPlaneVehicle"][0], report
+    assert "no Wagon_in.csv" in report["Wagon"][0], report
+    assert "HalfCarBogie_ref.csv" in report["HalfCarBogie"][0], report
