@@ -649,13 +649,19 @@ def test_a_limit_runs_the_first_cases_and_the_same_command_without_it_the_rest(t
     cmd = [sys.executable, "-m", "wheelflat_study", str(p), "--serial", "--out", str(tmp_path / "o"),
            "--no-progress", "--no-plots", "--runner", runner]
     r = subprocess.run(cmd + ["--limit", "2"], env=env, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0 and "(2 of 2 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
+    assert r.returncode == 0 and "(2 of 3 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
     ids = [c.id for c in load_study(str(p)).cases()]
     done = [json.loads(line)["id"] for line in open(tmp_path / "o" / "cases.jsonl")]
     assert sorted(done) == sorted(ids[:2])
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0 and "3 cases, 2 already done, 1 to run" in r.stdout + r.stderr, (r.stdout, r.stderr)
     assert "(3 of 3 cases, 0 failed)" in r.stdout, r.stdout
+    # A later run of the first case only keeps the others in the tables (the breaker's
+    # finding: they shrank to the limit's cases, cases.jsonl keeping them all).
+    r = subprocess.run(cmd + ["--limit", "1"], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "(3 of 3 cases, 0 failed)" in r.stdout, (r.stdout, r.stderr)
+    import pandas as pd
+    assert len(pd.read_parquet(tmp_path / "o" / "results.parquet")) == 3
     r = subprocess.run(cmd + ["--limit", "0"], env=env, capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--limit 0: 1 to" in r.stderr, r.stderr
 

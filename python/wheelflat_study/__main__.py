@@ -170,8 +170,13 @@ def _main(argv=None):
     failed = int((table["status"] == "error").sum()) if len(table) else 0
     # A case with no result (its runner or worker lost) is a failure too: it runs the
     # next time the same command runs.
-    missing = study.count() - len(table)
-    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {study.count()} cases, "
+    # (The tables hold every case of the study with a result; those --limit asked for
+    # and have none are the missing.)
+    import dataclasses
+    have = set(table["case_id"]) if len(table) else set()
+    missing = sum(1 for c in study.iter_cases() if c.id not in have)
+    whole = dataclasses.replace(study, limit=None).count()
+    print(f"results: {os.path.join(out, 'results.parquet')} and .csv ({len(table)} of {whole} cases, "
           f"{failed} failed" + (f", {missing} without a result: run the same command again to run them"
                                 if missing else "") + ")")
     failed += missing

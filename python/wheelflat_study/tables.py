@@ -133,9 +133,14 @@ def write_tables(study, out_dir, ident=None, units=None):
     offsets = load_done(out_dir, ident=ident, offsets=True)
     path = os.path.join(out_dir, "cases.jsonl")
 
+    # Every case of the study with a result, whatever --limit ran now: a run of the
+    # first cases does not drop the rest from the tables.
+    import dataclasses
+    whole = dataclasses.replace(study, limit=None)
+
     def records():
         with open(path, "rb") as fh:
-            for c in study.iter_cases():
+            for c in whole.iter_cases():
                 at = offsets.get(c.id)
                 if at is not None:
                     fh.seek(at)
