@@ -484,18 +484,22 @@ def run_wagon(paths, stop_time, track_params=None, wagon_params=None, record=Non
 
 
 def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None,
-                         record=None):
+                         record=None, jacobi=False, primary_output="mean_force"):
     """Couples TrackContact (`n` wheelsets) and the vehicle FMU `model` at the axle
     boxes (``interface`` = axle_box): the track carries every wheelset with its primary
     suspension, the vehicle the bodies above. Per communication step the side frames'
     motion above each axle box to the track, the track steps, its mean primary forces
-    back, the vehicle steps (track first). Returns the largest contact forces
-    ``[[left, right] of each wheelset]`` (N) over the run; ``record``, a list, receives
-    ``[time, the contact forces]`` at every communication point."""
+    back, the vehicle steps (track first). With ``jacobi`` both step from the same
+    communication point, as OSP libcosim and ecos do, the vehicle given the forces of
+    the point before the track steps. ``primary_output``: the track's output handed to
+    the vehicle, ``mean_force`` (for a sequential master) or ``force`` (for a Jacobi
+    one). Returns the largest contact forces ``[[left, right] of each wheelset]`` (N)
+    over the run; ``record``, a list, receives ``[time, the contact forces]`` at every
+    communication point."""
     track = Unit(paths["TrackContact"], "track")
     vehicle = Unit(paths[model], "vehicle")
     frames = every_wheelset(n, FRAMES)
-    primary = every_wheelset(n, PRIMARY)
+    primary = every_wheelset(n, tuple(f"primary.{s}.{primary_output}" for s in ("left", "right")))
     axle_box = every_wheelset(n, AXLE_BOX)
     forces = every_wheelset(n, FORCES)
     try:
@@ -509,9 +513,12 @@ def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_param
         steps = int(round(stop_time / comm_step))
         for k in range(steps):
             t = k * comm_step
+            if jacobi:  # both units' outputs of this point, before either gets an input
+                vehicle.set(axle_box, track.get(*primary))
             track.set(frames, vehicle.get(*frames))
             track.fmu.doStep(t, comm_step)
-            vehicle.set(axle_box, track.get(*primary))
+            if not jacobi:
+                vehicle.set(axle_box, track.get(*primary))
             vehicle.fmu.doStep(t, comm_step)
             if record is not None:
                 record.append([t + comm_step] + track.get(*forces))

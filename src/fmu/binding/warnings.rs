@@ -8,6 +8,7 @@ use super::watch::{HELD_STEPS, INTERPOLATED_STEPS};
 use crate::error::num;
 use crate::fmu::fmi2::StepWarning;
 use crate::sim::{TrackSpec, VehicleState, VehicleUnit};
+use crate::wheel::WheelProfile;
 
 /// The zone at the fixed rail end, in sleeper spans, where `fmi2DoStep` warns that the
 /// end's reflections raise the forces (the default start position, 1.37 m, is two
@@ -188,6 +189,36 @@ impl FmuModel {
                     .rate_warning()
                     .map(|m| StepWarning::once("axle rate", format!("at t = {time} s {m}")))
             };
+        }
+        // TrackContact at the axle boxes: any partner's exchange, unstable or fed the
+        // wrong output, shows as wheels that bounce more often than their flats strike.
+        if self.kind == Kind::TrackContact && matches!(sim.vehicle(), VehicleState::AxleBox(_)) {
+            let load = sim.static_load()[0].max(sim.static_load()[1]);
+            let lead = sim.wheelsets().iter().next().map(|w| &w.wheels()[0]);
+            let turn = lead.map_or(f64::INFINITY, |w| std::f64::consts::TAU * w.radius())
+                / sim.speed().abs().max(1e-3);
+            let wheels = sim.wheelsets().iter().map(|w| {
+                let WheelProfile::Flatted(l) = &w.wheels()[0];
+                let WheelProfile::Flatted(r) = &w.wheels()[1];
+                (w.forces(), [l.flats().len(), r.flats().len()])
+            });
+            if let Some((name, n, turn)) = self.watch.strikes_at_point(time, wheels, load, turn) {
+                contact = Some(StepWarning::once(
+                    "axle-box exchange bounces",
+                    format!(
+                        "at t = {time} s {name} has struck the rail {n} times in the last {} s \
+                     (nine tenths of a turn of the wheel), each at more than twice the static \
+                     load after lifting off, more than its flats explain: the axle-box exchange is unstable and \
+                     its forces are numerical. Likely causes: the communication step {} s is \
+                     beyond the stable step of your bogie's exchange (try half of it), or a \
+                     Jacobi master (every unit from the same point: OSP libcosim, ecos) hands \
+                     your bogie primary.*.mean_force, meant for a master that steps the track \
+                     first: under a Jacobi master read primary.*.force",
+                        num(turn),
+                        num(self.last_step)
+                    ),
+                ));
+            }
         }
         let TrackSpec::Discrete(p) = &sim.scenario().track else {
             return contact;
