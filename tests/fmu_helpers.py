@@ -61,3 +61,36 @@ def run_for(u, t0, n, h=2e-5, names=("contact.left.force", "contact.right.force"
         u.fmu.doStep(t0 + k * h, h)
         out.append(u.get(*names))
     return out
+
+
+def static_loads_and_held_forces(path, forces):
+    """A vehicle FMU alone: the static wheel loads it publishes in initialization mode
+    (``static_load.left``, ``.right``, N) and the contact forces `forces` its unset inputs
+    hold after it (N)."""
+    u = wf.Unit(path, "w")
+    try:
+        u.fmu.setupExperiment(startTime=0.0)
+        u.fmu.enterInitializationMode()
+        loads = u.get("static_load.left", "static_load.right")
+        u.fmu.exitInitializationMode()
+        return loads, u.get(*forces)
+    finally:
+        u.close()
+
+
+def drift_alone_at_rest(path, names, interface, steps=2000, h=1e-3):
+    """The largest change of the outputs `names` of a vehicle FMU left alone at rest (its
+    inputs unset) over `steps` steps of `h` s at `interface` (1 contact, 2 axle boxes)."""
+    import numpy as np
+    u = wf.Unit(path, "w")
+    try:
+        u.fmu.setupExperiment(startTime=0.0)
+        u.set_parameters({"interface": interface})
+        u.fmu.enterInitializationMode()
+        u.fmu.exitInitializationMode()
+        before = np.array(u.get(*names))
+        for k in range(steps):
+            u.fmu.doStep(k * h, h)
+        return float(np.max(np.abs(np.array(u.get(*names)) - before)))
+    finally:
+        u.close()

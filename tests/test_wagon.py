@@ -15,6 +15,7 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 import wheelflat_fmus as wf  # noqa: E402
+from fmu_helpers import drift_alone_at_rest, static_loads_and_held_forces  # noqa: E402
 
 ENDLESS = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
 # CoupledSystem with the wagon of the Wagon FMU's defaults: wheelbase 1.8 m, bogie
@@ -48,13 +49,7 @@ def coupled(paths, stop, params=None, interval=None):
 def test_the_wagon_publishes_an_eighth_of_its_weight_on_every_wheel(paths):
     # Table 4.4: four quarter car bodies, two bogies of twice the roll-plane vehicle's
     # bolster, side frames; 107.665 kN a wheel, as the thesis' vehicle.
-    u = wf.Unit(paths["Wagon"], "w")
-    u.fmu.setupExperiment(startTime=0.0)
-    u.fmu.enterInitializationMode()
-    loads = u.get("static_load.left", "static_load.right")
-    u.fmu.exitInitializationMode()
-    held = u.get(*FORCES)
-    u.close()
+    loads, held = static_loads_and_held_forces(paths["Wagon"], FORCES)
     assert loads == pytest.approx([STATIC_LOAD] * 2, rel=1e-12)
     # The inputs at rest are the forces that hold the wagon on its wheels.
     assert held == pytest.approx([STATIC_LOAD] * 8, rel=1e-9)
@@ -65,17 +60,8 @@ def test_the_wagon_alone_at_rest_stays_at_rest(paths):
     # and the wheels where they were (below 1e-8 m and rad), at both interfaces.
     names = ["carbody.z", "carbody.pitch", "carbody.roll", "wheelset[4].z", "sideframe.left.pitch"]
     for interface in (1, 2):
-        u = wf.Unit(paths["Wagon"], "w")
-        u.fmu.setupExperiment(startTime=0.0)
-        u.set_parameters({"interface": interface})
-        u.fmu.enterInitializationMode()
-        u.fmu.exitInitializationMode()
-        before = np.array(u.get(*names))
-        for k in range(2000):
-            u.fmu.doStep(k * 1e-3, 1e-3)
-        after = np.array(u.get(*names))
-        u.close()
-        assert np.max(np.abs(after - before)) < 1e-8, (interface, before, after)
+        drift = drift_alone_at_rest(paths["Wagon"], names, interface)
+        assert drift < 1e-8, (interface, drift)
 
 
 def test_coupled_system_with_the_wagon_on_a_level_track_stands_still(paths):
