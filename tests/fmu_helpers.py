@@ -94,3 +94,36 @@ def drift_alone_at_rest(path, names, interface, steps=2000, h=1e-3):
         return float(np.max(np.abs(np.array(u.get(*names)) - before)))
     finally:
         u.close()
+
+
+def at_the_tracks_step_against_coupled_system(paths, run, start, forces, stop=0.06):
+    """A vehicle FMU and TrackContact coupled at the track's step by `run`
+    (``wf.run_wagon``, ``wf.run_two_axle``: the endless track of `start`), against
+    CoupledSystem with `start` sampled at the same points: (the largest difference of
+    the contact forces `forces` (N), the run's peaks ``[[left, right] per wheelset]``)."""
+    import numpy as np
+    from fmpy import simulate_fmu
+    window = {k: v for k, v in start.items() if k.startswith("track.window.")}
+    rec = []
+    peak = run(paths, stop, track_params=window, record=rec)
+    got = np.array([x[1:] for x in rec])
+    h = rec[1][0] - rec[0][0]
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=stop, start_values=start, output=forces, output_interval=h)
+    ref = np.column_stack([r[n] for n in forces])[:len(got)]
+    assert got.shape == ref.shape
+    return float(np.max(np.abs(got - ref))), peak
+
+
+def axle_box_errors(paths, run_axle_box, wheelsets, start, stop=0.3, step=1e-3):
+    """A vehicle FMU coupled at the axle boxes by `run_axle_box` (fmpy's sequential
+    loop every `step` s, the endless track of `start`) against CoupledSystem with
+    `start`: (each wheel's largest contact force's relative error, CoupledSystem's
+    largest forces (N)), wheelset by wheelset, left then right."""
+    from fmpy import simulate_fmu
+    window = {k: v for k, v in start.items() if k.startswith("track.window.")}
+    peak = run_axle_box(paths, stop, step, track_params=window)
+    maxima = wf.every_wheelset(wheelsets, ("contact.left.max_force", "contact.right.max_force"))
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=stop, start_values=start, output=maxima)
+    ref = [r[n][-1] for n in maxima]
+    got = [x for w in peak for x in w]
+    return [g / m - 1 for g, m in zip(got, ref)], ref

@@ -15,7 +15,8 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 import wheelflat_fmus as wf  # noqa: E402
-from fmu_helpers import drift_alone_at_rest, static_loads_and_held_forces  # noqa: E402
+from fmu_helpers import (at_the_tracks_step_against_coupled_system, axle_box_errors,  # noqa: E402
+                         drift_alone_at_rest, static_loads_and_held_forces)
 
 ENDLESS = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
 FORCES = wf.every_wheelset(2, ("contact.left.force", "contact.right.force"))
@@ -82,16 +83,8 @@ def test_the_reference_flat_on_the_leading_wheel_at_70_km_h(paths, two_axle):
 
 
 def test_the_pair_at_the_tracks_step_is_coupled_system(paths, two_axle):
-    from fmpy import simulate_fmu
-    rec = []
-    peak = wf.run_two_axle(paths, 0.06, track_params=ENDLESS, record=rec)
-    got = np.array([x[1:] for x in rec])
-    h = rec[1][0] - rec[0][0]
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.06, start_values=two_axle, output=FORCES,
-                     output_interval=h)
-    ref = np.column_stack([r[n] for n in FORCES])[:len(got)]
-    assert got.shape == ref.shape
-    assert np.max(np.abs(got - ref)) <= 1e-9 * STATIC_LOAD
+    worst, peak = at_the_tracks_step_against_coupled_system(paths, wf.run_two_axle, two_axle, FORCES)
+    assert worst <= 1e-9 * STATIC_LOAD
     assert peak[0][0] > 2.5 * STATIC_LOAD
 
 
@@ -99,13 +92,7 @@ def test_the_two_axle_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent
     # fmpy's sequential loop every 1 ms, TrackContact carrying nothing above the axle
     # boxes (vehicle.model = two_axle): every wheel's largest force over 0.3 s within
     # 1 % of CoupledSystem's.
-    from fmpy import simulate_fmu
-    peak = wf.run_two_axle_axle_box(paths, 0.3, 1e-3, track_params=ENDLESS)
-    maxima = wf.every_wheelset(2, ("contact.left.max_force", "contact.right.max_force"))
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.3, start_values=two_axle, output=maxima)
-    ref = [r[n][-1] for n in maxima]
-    got = [x for w in peak for x in w]
-    errors = [g / m - 1 for g, m in zip(got, ref)]
+    errors, _ = axle_box_errors(paths, wf.run_two_axle_axle_box, 2, two_axle)
     print("two-axle wagon at the axle boxes, 1 ms, fmpy:", [f"{100 * e:+.3f} %" for e in errors])
     assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
 

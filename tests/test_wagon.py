@@ -15,7 +15,8 @@ import pytest
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 import wheelflat_fmus as wf  # noqa: E402
-from fmu_helpers import drift_alone_at_rest, static_loads_and_held_forces  # noqa: E402
+from fmu_helpers import (at_the_tracks_step_against_coupled_system, axle_box_errors,  # noqa: E402
+                         drift_alone_at_rest, static_loads_and_held_forces)
 
 ENDLESS = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
 # CoupledSystem with the wagon of the Wagon FMU's defaults: wheelbase 1.8 m, bogie
@@ -77,16 +78,8 @@ def test_the_wagon_with_track_contact_at_the_tracks_step_is_coupled_system(paths
     # The Wagon FMU and TrackContact (four wheelsets at the wagon's offsets) exchanged at
     # the track's step do CoupledSystem's arithmetic with vehicle.model = wagon: the
     # eight contact forces agree to 1e-9 through the leading wheel's first impact.
-    from fmpy import simulate_fmu
-    rec = []
-    peak = wf.run_wagon(paths, 0.06, track_params=ENDLESS, record=rec)
-    got = np.array([x[1:] for x in rec])
-    h = rec[1][0] - rec[0][0]
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.06, start_values=WAGON, output=FORCES,
-                     output_interval=h)
-    ref = np.column_stack([r[n] for n in FORCES])[:len(got)]
-    assert got.shape == ref.shape
-    assert np.max(np.abs(got - ref)) <= 1e-9 * STATIC_LOAD
+    worst, peak = at_the_tracks_step_against_coupled_system(paths, wf.run_wagon, WAGON, FORCES)
+    assert worst <= 1e-9 * STATIC_LOAD
     assert peak[0][0] > 2.5 * STATIC_LOAD
 
 
@@ -95,13 +88,7 @@ def test_the_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent(paths):
     # wagon) every 1 ms: every wheel's largest force over 0.3 s (the leading wheel's
     # flat hits at 34, 184 and 334 ms... within it: two impacts) within 1 % of
     # CoupledSystem's. Measured: 0.15 % on the second wheelset, 0.06 % on the flat.
-    from fmpy import simulate_fmu
-    peak = wf.run_wagon_axle_box(paths, 0.3, 1e-3, track_params=ENDLESS)
-    maxima = wf.every_wheelset(4, ("contact.left.max_force", "contact.right.max_force"))
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.3, start_values=WAGON, output=maxima)
-    ref = [r[n][-1] for n in maxima]
-    got = [x for w in peak for x in w]
-    errors = [g / m - 1 for g, m in zip(got, ref)]
+    errors, ref = axle_box_errors(paths, wf.run_wagon_axle_box, 4, WAGON)
     assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
     # The impact is the flat's: 2.8 times the static load on the flat wheel, and the
     # trailing wheelset of the same bogie feels it (through the rails and the side
