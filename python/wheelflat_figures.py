@@ -71,16 +71,9 @@ def read_pages():
             crlf.add(p)
             text = text.replace("\r\n", "\n")
         markers(text, p)
-        transcripts_of(text, p)
+        transcripts(text, p)
         texts[p] = text
     return texts, crlf
-
-
-def transcripts_of(text, page):
-    try:
-        return transcripts(text)
-    except MarkerError as e:
-        raise MarkerError(f"{page}:{str(e)[5:]}") from None
 
 
 def pages():
@@ -394,38 +387,21 @@ def source_derivatives():
     return {"derivatives.table": "\n\n" + table + "\n\n", "derivatives.reference": kn(ref_peak)}
 
 
-def carrier_peaks(fmu, model_params, run):
-    """A vehicle of several wheelsets at the axle boxes (fmpy's loop every 1 ms, 0.3 s,
-    the 20 m window), as couple-a-vehicle.md's blocks run it, and CoupledSystem alike:
-    ([(left, right) per wheelset], the same of CoupledSystem) in N."""
-    from fmpy import simulate_fmu
-    paths = fmu_paths()
-    endless = {"track.window.ahead": 20.0, "track.window.behind": 20.0}
-    peaks = run(paths, 0.3, 1e-3, track_params=endless)
-    n = len(peaks)
-    names = wf.every_wheelset(n, ("contact.left.max_force", "contact.right.max_force"))
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=0.3, output=names,
-                     start_values=dict(endless, **model_params))
-    return peaks, [(r[names[2 * k]][-1], r[names[2 * k + 1]][-1]) for k in range(n)]
-
-
 def source_wagon():
-    """couple-a-vehicle.md's Wagon block."""
-    peaks, ref = carrier_peaks("Wagon", {"vehicle.model": 3, "wheelsets": 4, "wheelset[2].offset": 1.8,
-                                         "wheelset[3].offset": 10.0, "wheelset[4].offset": 11.8},
-                               wf.run_wagon_axle_box)
-    rear = max(max(p) for p in peaks[2:])
-    return {"wagon.left": kn(peaks[0][0], 1), "wagon.coupled_left": kn(ref[0][0], 1),
-            "wagon.trailing_left": kn(peaks[1][0], 1), "wagon.rear": kn(1e3 * math.ceil(rear / 1e3), 0)}
+    """couple-a-vehicle.md's Wagon block: at the axle boxes, fmpy's loop every 1 ms,
+    0.3 s, and CoupledSystem alike (the shipped systems' parameters)."""
+    import wheelflat_masters as wm
+    got, ref = wf.axle_box_against_coupled_system(fmu_paths(), wf.run_wagon_axle_box, wm.coupled_params("Wagon"))
+    rear = max(got[4:])
+    return {"wagon.left": kn(got[0], 1), "wagon.coupled_left": kn(ref[0], 1),
+            "wagon.trailing_left": kn(got[2], 1), "wagon.rear": kn(1e3 * math.ceil(rear / 1e3), 0)}
 
 
 def source_two_axle():
-    """couple-a-vehicle.md's TwoAxleWagon block, and its static wheel load."""
-    from fmpy import read_model_description
-    model = wf.vehicle_kind("TwoAxleWagon")["value"]
-    peaks, ref = carrier_peaks("TwoAxleWagon", {"vehicle.model": model, "wheelsets": 2, "wheelset[2].offset": 9.0},
-                               wf.run_two_axle_axle_box)
-    md = read_model_description(fmu_paths()["TwoAxleWagon"])
+    """couple-a-vehicle.md's TwoAxleWagon block, as the Wagon's, and its static wheel load."""
+    import wheelflat_masters as wm
+    got, _ = wf.axle_box_against_coupled_system(fmu_paths(), wf.run_two_axle_axle_box,
+                                                wm.coupled_params("TwoAxleWagon"))
     unit = wf.Unit(fmu_paths()["TwoAxleWagon"], "static")
     try:
         unit.fmu.setupExperiment(startTime=0.0)
@@ -433,9 +409,8 @@ def source_two_axle():
         static = unit.get("static_load.left")[0]
     finally:
         unit.close(terminate=False)
-    del md
-    return {"two_axle.left": kn(peaks[0][0], 1), "two_axle.right": kn(peaks[0][1], 1),
-            "two_axle.trailing": kn(1e3 * math.ceil(max(peaks[1]) / 1e3), 0), "two_axle.static": kn(static)}
+    return {"two_axle.left": kn(got[0], 1), "two_axle.right": kn(got[1], 1),
+            "two_axle.trailing": kn(1e3 * math.ceil(max(got[2:4]) / 1e3), 0), "two_axle.static": kn(static)}
 
 
 def source_masters():
@@ -699,7 +674,7 @@ def same_figure(committed, current):
 
 # ---------------------------------------------------------------------------- transcripts
 
-def transcripts(text):
+def transcripts(text, page="the page"):
     """(command, output lines, (first, last) line index of the output) of each console
     block whose first line is ``$ COMMAND`` and that shows one command."""
     out, lines, i = [], text.split("\n"), 0
@@ -709,7 +684,7 @@ def transcripts(text):
             while j < len(lines) and not lines[j].startswith("```"):
                 j += 1
             if j == len(lines):
-                raise MarkerError(f"line {i + 1}: a ```console block that is never closed")
+                raise MarkerError(f"{page}:{i + 1}: a ```console block that is never closed")
             body = lines[i + 1:j]
             if body and body[0].startswith("$ ") and sum(ln.startswith("$ ") for ln in body) == 1:
                 out.append((body[0][2:].strip(), body[1:], (i + 2, j)))

@@ -557,3 +557,17 @@ if __name__ == "__main__":
                     "(fmpy, dask, pandas, pyarrow, libcosimpy, ecospy), which the other commands run in; "
                     "imported, the coupling helpers (run_pair, run_carrier, run_carrier_axle_box, ...).").parse_args()
     install_venv()
+
+
+def axle_box_against_coupled_system(paths, run_axle_box, start, stop_time=0.3, comm_step=1e-3):
+    """A vehicle FMU coupled at the axle boxes by `run_axle_box` (:func:`run_wagon_axle_box`,
+    :func:`run_two_axle_axle_box`, ...: fmpy's sequential loop every `comm_step` s on the
+    track window of `start`) and CoupledSystem with `start` (its vehicle.model, wheelsets
+    and offsets): every wheel's largest contact force over `stop_time` in both, wheelset
+    by wheelset, left then right, as two lists (N)."""
+    from fmpy import simulate_fmu
+    window = {k: v for k, v in start.items() if k.startswith("track.window.")}
+    got = [x for w in run_axle_box(paths, stop_time, comm_step, track_params=window) for x in w]
+    maxima = every_wheelset(len(got) // 2, ("contact.left.max_force", "contact.right.max_force"))
+    r = simulate_fmu(paths["CoupledSystem"], stop_time=stop_time, start_values=start, output=maxima)
+    return got, [r[n][-1] for n in maxima]

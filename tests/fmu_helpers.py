@@ -114,16 +114,8 @@ def at_the_tracks_step_against_coupled_system(paths, run, start, forces, stop=0.
     return float(np.max(np.abs(got - ref))), peak
 
 
-def axle_box_errors(paths, run_axle_box, wheelsets, start, stop=0.3, step=1e-3):
-    """A vehicle FMU coupled at the axle boxes by `run_axle_box` (fmpy's sequential
-    loop every `step` s, the endless track of `start`) against CoupledSystem with
-    `start`: (each wheel's largest contact force's relative error, CoupledSystem's
-    largest forces (N)), wheelset by wheelset, left then right."""
-    from fmpy import simulate_fmu
-    window = {k: v for k, v in start.items() if k.startswith("track.window.")}
-    peak = run_axle_box(paths, stop, step, track_params=window)
-    maxima = wf.every_wheelset(wheelsets, ("contact.left.max_force", "contact.right.max_force"))
-    r = simulate_fmu(paths["CoupledSystem"], stop_time=stop, start_values=start, output=maxima)
-    ref = [r[n][-1] for n in maxima]
-    got = [x for w in peak for x in w]
+def axle_box_errors(paths, run_axle_box, start):
+    """:func:`wf.axle_box_against_coupled_system` as relative errors: (each wheel's
+    largest contact force's error against CoupledSystem's, CoupledSystem's forces (N))."""
+    got, ref = wf.axle_box_against_coupled_system(paths, run_axle_box, start)
     return [g / m - 1 for g, m in zip(got, ref)], ref

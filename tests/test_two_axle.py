@@ -92,7 +92,7 @@ def test_the_two_axle_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent
     # fmpy's sequential loop every 1 ms, TrackContact carrying nothing above the axle
     # boxes (vehicle.model = two_axle): every wheel's largest force over 0.3 s within
     # 1 % of CoupledSystem's.
-    errors, _ = axle_box_errors(paths, wf.run_two_axle_axle_box, 2, two_axle)
+    errors, _ = axle_box_errors(paths, wf.run_two_axle_axle_box, two_axle)
     print("two-axle wagon at the axle boxes, 1 ms, fmpy:", [f"{100 * e:+.3f} %" for e in errors])
     assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
 

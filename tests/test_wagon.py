@@ -88,7 +88,7 @@ def test_the_wagon_at_1_ms_couples_at_the_axle_boxes_within_one_percent(paths):
     # wagon) every 1 ms: every wheel's largest force over 0.3 s (the leading wheel's
     # flat hits at 34, 184 and 334 ms... within it: two impacts) within 1 % of
     # CoupledSystem's. Measured: 0.15 % on the second wheelset, 0.06 % on the flat.
-    errors, ref = axle_box_errors(paths, wf.run_wagon_axle_box, 4, WAGON)
+    errors, ref = axle_box_errors(paths, wf.run_wagon_axle_box, WAGON)
     assert max(abs(e) for e in errors) < 0.01, [f"{100 * e:+.3f} %" for e in errors]
     # The impact is the flat's: 2.8 times the static load on the flat wheel, and the
     # trailing wheelset of the same bogie feels it (through the rails and the side
