@@ -560,3 +560,66 @@ def test_trackcontact_warns_of_an_axle_box_exchange_that_bounces_for_any_partner
         peaks = wf.run_carrier_axle_box(paths, "HalfCarBogie", 2, 0.3, track_params=endless, **kw)
         assert "has struck the rail" not in capfd.readouterr().out, kw
         assert abs(peaks[0][0] / 303.98e3 - 1) < 0.01, (kw, peaks)
+
+
+# ------------------------------------------------------------------ a partner TrackContact does not know (issue 41)
+
+def _axle_box_run(paths, capfd, stop=0.15, **kw):
+    """The half-car bogie at the axle boxes in fmpy's loop (wf.run_carrier_axle_box),
+    the default endless track; its peaks and TrackContact's warnings (their messages)."""
+    model = kw.pop("model", "HalfCarBogie")
+    peaks = wf.run_carrier_axle_box(paths, model, 4 if model == "Wagon" else 2, stop, **kw)
+    out = capfd.readouterr().out
+    return peaks, [x for x in out.splitlines() if "WARNING" in x]
+
+
+@pytest.mark.parametrize("jacobi, output, wrong", [
+    (True, "force", None), (False, "mean_force", None),
+    (True, "mean_force", "connect primary.*.force"), (False, "force", "connect primary.*.mean_force")])
+def test_trackcontact_tells_the_output_its_master_should_hand_on(paths, capfd, jacobi, output, wrong):
+    # Issue 41 (item 3): the same calls reach TrackContact under both kinds of master;
+    # the side frames' velocities tell which of its four forces the bogie held, so a
+    # Jacobi master handing on the mean force (a step late) and a sequential one handing
+    # on the point force (a step early) are each warned of, once, naming the output to
+    # use; the right choices are not.
+    _, warnings = _axle_box_run(paths, capfd, comm_step=1e-3, jacobi=jacobi, primary_output=output)
+    told = [x for x in warnings if "the bogie holds primary" in x]
+    if wrong is None:
+        assert warnings == [], warnings
+    else:
+        assert len(told) == 1 and wrong in told[0], warnings
+
+
+def test_trackcontact_fits_the_partners_side_frames_and_auto_takes_them(paths, capfd):
+    # Issue 41 (items 2, 5): TrackContact's copy of the side frames at half the bogie's
+    # (vehicle.sideframe.mass 111.875 kg per axle box, pitch inertia 90 kg m^2; the
+    # bogie's are 223.75 and 180). The fit from the exchange finds the bogie's and
+    # names them; with vehicle.sideframe.source = auto it takes them, and the run is the
+    # matched copy's.
+    half = {"vehicle.sideframe.mass": 111.875, "vehicle.sideframe.pitch_inertia": 90.0}
+    run = dict(comm_step=1e-3, jacobi=True, primary_output="force")
+    _, warnings = _axle_box_run(paths, capfd, track_params=half, **run)
+    copy = [x for x in warnings if "the partner's side frames, fitted" in x]
+    assert len(copy) == 1, warnings
+    import re
+    mass = float(re.search(r"set vehicle.sideframe.mass = ([0-9.e+-]+) kg", copy[0]).group(1))
+    pitch = float(re.search(r"vehicle.sideframe.pitch_inertia = ([0-9.e+-]+) kg m\^2, or", copy[0]).group(1))
+    assert mass == pytest.approx(223.75, rel=0.01) and pitch == pytest.approx(180.0, rel=1e-6), copy
+    matched, w = _axle_box_run(paths, capfd, stop=0.3, **run)
+    assert w == []
+    auto, w = _axle_box_run(paths, capfd, stop=0.3, track_params=dict(half, **{"vehicle.sideframe.source": 2}), **run)
+    assert w == []
+    for a, b in zip(np.ravel(auto), np.ravel(matched)):
+        assert a == pytest.approx(b, rel=2e-3)
+
+
+def test_trackcontact_warns_of_a_step_beyond_the_exchanges_stable_one_for_the_master_it_sees(paths, capfd):
+    # Issue 41 (item 1): from what it carries TrackContact estimates the exchange's
+    # stable steps (2.74 ms under a Jacobi master with the half-car's side frames, 20 ms
+    # under a sequential one); it warns, for any partner, once it has seen the master's
+    # kind. (The HalfCarBogie warns of its own step too: those lines are its own.)
+    _, warnings = _axle_box_run(paths, capfd, comm_step=4e-3, jacobi=True, primary_output="force")
+    mine = [x for x in warnings if "estimated from what TrackContact carries" in x]
+    assert len(mine) == 1 and "above 0.002738" in mine[0] and "Jacobi master (every unit from the same point), as the exchange shows" in mine[0], warnings
+    _, warnings = _axle_box_run(paths, capfd, comm_step=4e-3)
+    assert not [x for x in warnings if "estimated from what TrackContact carries" in x], warnings

@@ -355,6 +355,34 @@ impl Simulation {
         }
     }
 
+    /// Carries side frames of `inertia` above every wheelset's axle boxes from now on
+    /// ([`crate::vehicle::PrimaryLink::set_inertia`]).
+    ///
+    /// Errors: no wheelset cut at its axle boxes; an inertia the links refuse (nothing
+    /// changed then).
+    pub fn set_side_frame_inertia(
+        &mut self,
+        inertia: crate::vehicle::SideFrameInertia,
+    ) -> Result<()> {
+        // Tried on a copy first: every link carries the same side frames, so one that
+        // takes them is all that takes them.
+        let Some(mut first) = self.wheelsets.iter().find_map(|w| match &w.vehicle {
+            VehicleState::AxleBox(link) => Some(link.clone()),
+            _ => None,
+        }) else {
+            return Err(Error::Unsupported(
+                "side frames of a simulation not cut at its axle boxes".into(),
+            ));
+        };
+        first.set_inertia(inertia)?;
+        for w in self.wheelsets.iter_mut() {
+            if let VehicleState::AxleBox(link) = &mut w.vehicle {
+                link.set_inertia(inertia)?;
+            }
+        }
+        Ok(())
+    }
+
     /// The primary suspension of wheelset `k`: its forces `[left, right]` (N, pressing
     /// the wheelset down) averaged over the steps since the side frames were last set
     /// (the impulse the bogie takes over its communication step), and the axle boxes'

@@ -287,18 +287,7 @@ impl PrimaryLink {
     pub fn new(p: &RollPlaneParams, dt: f64, inertia: SideFrameInertia) -> Result<PrimaryLink> {
         crate::limits::check("vehicle.primary.stiffness", p.primary_stiffness)?;
         crate::limits::check("vehicle.primary.damping", p.primary_damping)?;
-        if !(inertia == SideFrameInertia::NONE
-            || inertia.direct.is_finite()
-                && inertia.direct > 0.0
-                && inertia.cross.abs() < inertia.direct)
-        {
-            return Err(out_of_range(
-                "side frame mobility",
-                inertia.direct,
-                "a positive direct mobility 1/m + l^2/J above the cross mobility's magnitude, \
-                 or none",
-            ));
-        }
+        check_inertia(inertia)?;
         Ok(PrimaryLink {
             body: WheelsetBody::new(p, dt)?,
             stiffness: p.primary_stiffness,
@@ -334,6 +323,32 @@ impl PrimaryLink {
     /// The side frames' inertia.
     pub fn inertia(&self) -> SideFrameInertia {
         self.inertia
+    }
+
+    /// Carries side frames of `inertia` from now on, the held load from above kept (the
+    /// static forces it balances): what TrackContact fitted of its partner's
+    /// ([`super::PartnerFit`], `vehicle.sideframe.source = auto`).
+    ///
+    /// Errors: an inertia [`PrimaryLink::new`] refuses, or [`SideFrameInertia::NONE`]
+    /// for side frames that had one (or the reverse).
+    pub fn set_inertia(&mut self, inertia: SideFrameInertia) -> Result<()> {
+        check_inertia(inertia)?;
+        let (old, new) = (
+            self.inertia.direct + self.inertia.cross,
+            inertia.direct + inertia.cross,
+        );
+        if (old == 0.0) != (new == 0.0) {
+            return Err(out_of_range(
+                "side frame mobility",
+                inertia.direct,
+                "side frames where the track carried them, none where it carried none",
+            ));
+        }
+        if old != 0.0 {
+            self.free = self.free.map(|a| a * new / old);
+        }
+        self.inertia = inertia;
+        Ok(())
     }
 
     /// Static equilibrium: the wheels at `z_wheel` (m) on the static contact forces `p`
@@ -436,11 +451,12 @@ impl PrimaryLink {
     }
 
     /// Values of [`PrimaryLink::state_vector`].
-    const STATE_LEN: usize = 22;
+    const STATE_LEN: usize = 24;
 
     /// The wheelset's state (5), then the side frames at the input (z, v), the steps
     /// and force sums since the last input, the side frames now (z, v), the load from
-    /// above, the partner's and the last primary forces: 22 values.
+    /// above, the partner's and the last primary forces, the side frames' mobilities
+    /// (direct, cross; [`PrimaryLink::set_inertia`] may change them): 24 values.
     pub fn state_vector(&self) -> Vec<f64> {
         let mut v = self.body.state_vector();
         v.extend(self.frame_z);
@@ -452,6 +468,7 @@ impl PrimaryLink {
         v.extend(self.free);
         v.extend(self.partner);
         v.extend(self.last);
+        v.extend([self.inertia.direct, self.inertia.cross]);
         v
     }
 
@@ -464,6 +481,11 @@ impl PrimaryLink {
                 format!("{} values, a whole step count", Self::STATE_LEN),
             ));
         }
+        let inertia = SideFrameInertia {
+            direct: v[22],
+            cross: v[23],
+        };
+        check_inertia(inertia)?;
         self.body.set_state_vector(&v[..5])?;
         let pair = |i: usize| [v[i], v[i + 1]];
         self.frame_z = pair(5);
@@ -475,6 +497,25 @@ impl PrimaryLink {
         self.free = pair(16);
         self.partner = pair(18);
         self.last = pair(20);
+        self.inertia = inertia;
         Ok(())
     }
+}
+
+/// Refuses an inertia that is not [`SideFrameInertia::NONE`] or a positive finite direct
+/// mobility with a cross mobility of smaller magnitude.
+fn check_inertia(inertia: SideFrameInertia) -> Result<()> {
+    if !(inertia == SideFrameInertia::NONE
+        || inertia.direct.is_finite()
+            && inertia.direct > 0.0
+            && inertia.cross.abs() < inertia.direct)
+    {
+        return Err(out_of_range(
+            "side frame mobility",
+            inertia.direct,
+            "a positive direct mobility 1/m + l^2/J above the cross mobility's magnitude, \
+             or none",
+        ));
+    }
+    Ok(())
 }

@@ -301,6 +301,101 @@ fn track_side<B: SprungBody>(
     })
 }
 
+/// The side frames TrackContact carries above the axle boxes, standing in for a partner's
+/// bogie that TrackContact does not know: free bodies of the carried inertia
+/// ([`SideFrameInertia`]) at the axle boxes, held at rest by the static load from above
+/// (the secondary suspension, far softer than the primary, is left out), moved exactly
+/// under the forces held over each communication step, as any integrator that resolves
+/// the step does.
+#[derive(Debug, Clone)]
+struct CarriedFrames {
+    inertia: SideFrameInertia,
+    /// Each side frame spans the axle boxes of two wheelsets (the half-car bogie's and
+    /// the wagon's); else one side frame per axle box.
+    shared: bool,
+    /// Acceleration from above at each axle box (m/s^2), wheelset by wheelset, left
+    /// then right.
+    free: Vec<f64>,
+    z: Vec<f64>,
+    v: Vec<f64>,
+    dt: f64,
+}
+
+impl SprungBody for CarriedFrames {
+    fn boxes(&self) -> usize {
+        self.z.len()
+    }
+    fn frames(&self) -> (Vec<f64>, Vec<f64>) {
+        (self.z.clone(), self.v.clone())
+    }
+    fn step_boxes(&mut self, f: &[f64]) {
+        let n = self.z.len();
+        for i in 0..n {
+            // The other wheelset's axle box on the same side frame.
+            let other = if self.shared { f[(i + 2) % n] } else { 0.0 };
+            let a = self.free[i] + self.inertia.direct * f[i] + self.inertia.cross * other;
+            self.z[i] += self.dt * (self.v[i] + 0.5 * self.dt * a);
+            self.v[i] += self.dt * a;
+        }
+    }
+    fn state(&self) -> Vec<f64> {
+        let mut s = vec![self.dt];
+        s.extend(&self.z);
+        s.extend(&self.v);
+        s
+    }
+    fn set_state(&mut self, s: &[f64]) {
+        let n = self.z.len();
+        self.z.copy_from_slice(&s[1..=n]);
+        self.v.copy_from_slice(&s[n + 1..=2 * n]);
+    }
+    fn set_step(&mut self, dt: f64) {
+        self.dt = dt;
+    }
+}
+
+/// [`ExchangeLimits`] of the axle-box exchange as TrackContact can estimate it for any
+/// partner, from what it carries: the wheelsets of `wheelset` (mass, roll inertia,
+/// primary stiffness, damping and spacing, gravity) on contact springs of `support` (N/m
+/// per wheel) under the static wheel loads `static_load` `[left, right]` (N), and above
+/// them the side frames of `inertia`, spanning two wheelsets' axle boxes when `shared`.
+/// The partner is taken as those side frames alone, moved exactly under the forces it
+/// holds over a step ([`CarriedFrames`]): its secondary suspension and the bodies above
+/// are slow beside the exchange's fast modes, and its integrator is its own. `None` with
+/// nothing carried ([`SideFrameInertia::NONE`]: the partner's bodies there are unknown).
+///
+/// Errors: a parameter [`PrimaryLink::new`] refuses.
+pub fn carried_limits(
+    wheelset: &RollPlaneParams,
+    inertia: SideFrameInertia,
+    shared: bool,
+    static_load: [f64; 2],
+    support: f64,
+) -> Result<Option<ExchangeLimits>> {
+    if inertia == SideFrameInertia::NONE {
+        return Ok(None);
+    }
+    let wheelsets = if shared { 2 } else { 1 };
+    let k1 = wheelset.primary_stiffness;
+    let w = 0.5 * wheelset.wheelset_mass * wheelset.gravity;
+    // The static primary forces at the boxes (N), wheelset by wheelset, left then right.
+    let f: Vec<f64> = (0..2 * wheelsets).map(|i| static_load[i % 2] - w).collect();
+    let body = CarriedFrames {
+        inertia,
+        shared,
+        free: f
+            .iter()
+            .map(|fi| -(inertia.direct + inertia.cross) * fi)
+            .collect(),
+        z: f.iter().map(|fi| -fi / k1).collect(),
+        v: vec![0.0; 2 * wheelsets],
+        dt: TRACK_STEP,
+    };
+    let track = track_side(&body, wheelset, inertia, &vec![0.0; 2 * wheelsets], support)?;
+    // One step of the partner per communication step: it moves exactly.
+    Ok(Some(limits_of(&body, &track, f64::INFINITY)))
+}
+
 fn limits_of<B: SprungBody>(body: &B, track: &TrackSide, base: f64) -> ExchangeLimits {
     ExchangeLimits {
         sequential: largest_stable(body, track, base, false),

@@ -28,6 +28,7 @@ mod half_car;
 mod half_car_bogie;
 mod linear_body;
 mod lumped;
+mod partner_fit;
 mod rail_vehicle;
 mod registry;
 mod roll_plane;
@@ -40,13 +41,14 @@ mod wagon_motion;
 mod wagon_tests;
 
 pub use axle_box::{PrimaryLink, SideFrameInertia, WheelsetBody};
-pub use exchange::{CONTACT_STIFFNESS, ExchangeLimits};
+pub use exchange::{CONTACT_STIFFNESS, ExchangeLimits, carried_limits};
 pub use half_car::{
     HALF_CAR_DOF_NAMES, HALF_CAR_DOFS, HalfCarMatrix, HalfCarParams, HalfCarVector,
 };
 pub use half_car_bogie::{HalfCarBogie, Quad, SprungHalfCar};
 pub use linear_body::{LinearBody, LinearVehicle, SprungLinearBody};
 pub use lumped::{LumpedTrack, LumpedTrackParams, LumpedWheelParams, LumpedWheels};
+pub use partner_fit::{HeldForce, PartnerEstimate, PartnerFit};
 pub use rail_vehicle::{Axles, Bodies, CarrierModel, MAX_AXLES, RailVehicle, SprungVehicle};
 pub use registry::{
     AboveAxleBoxes, CarrierSpec, VEHICLE_KINDS, Values, VehicleKind, kind_of_fmu, kind_of_item,

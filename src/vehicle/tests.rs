@@ -335,3 +335,87 @@ fn half_car_above_its_primary_suspension_converges_to_the_whole() {
     let order = (e1 / e2).log2();
     assert!((0.8..1.2).contains(&order), "{e1} {e2} {order}");
 }
+
+/// The exchange's estimated stable steps (ms) of a vehicle's own bogie against what
+/// TrackContact estimates from the side frames it carries alone ([`carried_limits`]).
+fn own_and_carried_limits(
+    sprung: &dyn SprungVehicle,
+    wheelset: &RollPlaneParams,
+    inertia: SideFrameInertia,
+    shared: bool,
+    z: &Axles,
+    base: f64,
+    load: [f64; 2],
+) -> (ExchangeLimits, ExchangeLimits) {
+    let own = sprung.exchange_limits(z, base, CONTACT_STIFFNESS).unwrap();
+    let carried = carried_limits(wheelset, inertia, shared, load, CONTACT_STIFFNESS)
+        .unwrap()
+        .unwrap();
+    (own, carried)
+}
+
+#[test]
+fn the_carried_side_frames_alone_estimate_the_exchanges_stable_steps_of_the_whole_bogie() {
+    // The roll-plane vehicle and the half-car bogie of table 4.4: their own estimates
+    // (the whole bogie with its substeps) and TrackContact's from the side frames it
+    // carries alone. The exchange's fast modes are the side frames on their primary
+    // springs, so the two agree; the bogie's own central differences, whose velocity
+    // lags half a substep, make its Jacobi limit the lower.
+    let p = table_4_4();
+    let mut bogie = SprungBogie::new(p, p.default_dt()).unwrap();
+    let z = [[-1.2e-3; 2], [0.0; 2], [0.0; 2], [0.0; 2]];
+    SprungVehicle::set_static(&mut bogie, &z).unwrap();
+    let load = [p.static_wheel_load(); 2];
+    let (own, carried) = own_and_carried_limits(
+        &bogie,
+        &p,
+        SideFrameInertia::single(p.sideframe_mass),
+        false,
+        &z,
+        p.default_dt(),
+        load,
+    );
+    // Same scan, same bins (ratio 1.1): equal to the last figure.
+    assert_eq!(own, carried, "roll-plane");
+    let h = half_car();
+    let mut above = SprungHalfCar::new(h, h.default_dt()).unwrap();
+    let zq = axles([[-1.2e-3; 2], [-1.2e-3; 2]]);
+    SprungVehicle::set_static(&mut above, &zq).unwrap();
+    let (own_h, carried_h) = own_and_carried_limits(
+        &above,
+        &h.wheelset(),
+        h.above_axle_boxes(),
+        true,
+        &zq,
+        h.default_dt(),
+        [h.static_wheel_load(); 2],
+    );
+    assert_eq!(own_h, carried_h, "half-car");
+    // Table 4.4: 4.0 ms (roll-plane) and 2.3 ms (this half-car) under Jacobi, 20 ms (the
+    // scan's end) under a sequential master.
+    assert!((own.jacobi - 4.01e-3).abs() < 0.01e-3, "{own:?}");
+    assert!((own_h.jacobi - 2.26e-3).abs() < 0.01e-3, "{own_h:?}");
+    assert!(own.sequential > 20e-3 && own_h.sequential > 20e-3);
+    // Side frames of half the mass and pitch inertia: the Jacobi limit falls by about
+    // sqrt(2) or more (1.28 ms), the partner's side frames being the fast modes.
+    let light = carried_limits(
+        &h.wheelset(),
+        SideFrameInertia::pitching(
+            0.5 * h.sideframe_mass,
+            0.5 * h.sideframe_pitch_inertia,
+            h.wheelbase,
+        ),
+        true,
+        [h.static_wheel_load(); 2],
+        CONTACT_STIFFNESS,
+    )
+    .unwrap()
+    .unwrap();
+    assert!(light.jacobi < own_h.jacobi / 2f64.sqrt(), "{light:?}");
+    // Nothing carried: no estimate.
+    assert!(
+        carried_limits(&p, SideFrameInertia::NONE, false, load, CONTACT_STIFFNESS)
+            .unwrap()
+            .is_none()
+    );
+}

@@ -8,11 +8,13 @@ mod inputs;
 mod model;
 mod outputs;
 mod parameters;
+mod partner;
 mod unit;
 mod warnings;
 mod watch;
 
 pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};
+pub use partner::{COPY_TOLERANCE, FIT_STEP_RADIANS, JUMP_TOLERANCE};
 pub use unit::FmuModel;
 pub use warnings::END_ZONE_SPANS;
 

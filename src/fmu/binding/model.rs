@@ -7,6 +7,7 @@ use super::Kind;
 use super::datum::InputDatum;
 use super::derivatives::{name_of, no_derivative, wheel_input};
 use super::parameters::{check_table, scenario, vehicle_unit_params, with_tables};
+use super::partner::PartnerWatch;
 use super::unit::{Engine, FmuModel, Published};
 use super::watch::ContactWatch;
 use crate::error::{Error, num};
@@ -156,6 +157,21 @@ impl Model for FmuModel {
             Engine::Sim(sim) => ContactWatch::new(sim.wheelsets().len()),
             Engine::Vehicle(_) => ContactWatch::new(0),
         };
+        let partner = match &engine {
+            Engine::Sim(sim) if kind == Kind::TrackContact => {
+                // The FMI layer holds the enumeration to its items (its range, at set).
+                let auto = match enums::side_frame_source::Item::of(
+                    values[vr::VEHICLE_SIDEFRAME_SOURCE as usize],
+                )
+                .expect("vehicle.sideframe.source is one of its items")
+                {
+                    enums::side_frame_source::Item::Configured => false,
+                    enums::side_frame_source::Item::Auto => true,
+                };
+                PartnerWatch::new(sim, auto)?
+            }
+            _ => None,
+        };
         let spans = values[vr::TRACK_SPANS as usize];
         let default_spans = table.var(vr::TRACK_SPANS).map(|v| v.start);
         let unused_spans = match &engine {
@@ -172,6 +188,7 @@ impl Model for FmuModel {
             last_step: 0.0,
             datum,
             watch,
+            partner,
             master_end: 0.0,
             started: false,
             off_grid_steps: 0,
@@ -255,6 +272,9 @@ impl Model for FmuModel {
                     self.published.step = dt;
                 }
                 let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                if let Some(p) = &mut self.partner {
+                    p.before_step(sim, self.last_step);
+                }
                 if let Err(mut e) = sim.advance_to(plan) {
                     // A run beyond the health bounds that the input datum may explain
                     // names it (issue 38, N5).
@@ -271,6 +291,9 @@ impl Model for FmuModel {
                 self.last_step = end - self.master_end;
                 self.master_end = end;
                 self.datum.fix();
+                if let Some(p) = &mut self.partner {
+                    p.after_step(sim);
+                }
                 if self.kind == Kind::CoupledSystem {
                     sim.check_sample()?;
                 }
@@ -330,6 +353,9 @@ impl Model for FmuModel {
         }
         self.datum = restored;
         self.watch.restart();
+        if let Some(p) = &mut self.partner {
+            p.restart();
+        }
         if let Engine::Sim(sim) = &self.engine {
             self.master_end = sim.time();
             // The step in use, fitted to a master's first step or not.

@@ -5,6 +5,7 @@
 
 use super::Kind;
 use super::datum::InputDatum;
+use super::partner::PartnerWatch;
 use super::watch::ContactWatch;
 use crate::fmu::vars::TRAILING;
 use crate::sim::{Simulation, VehicleUnit};
@@ -35,6 +36,8 @@ pub struct FmuModel {
     pub(super) datum: InputDatum,
     /// What TrackContact sees of its exchange at the contact interface.
     pub(super) watch: ContactWatch,
+    /// What TrackContact at the axle boxes knows of its partner (side frames carried).
+    pub(super) partner: Option<PartnerWatch>,
     /// The end of the master's last step, in model time (s).
     pub(super) master_end: f64,
     /// A vehicle's first step was checked against its forces at rest.

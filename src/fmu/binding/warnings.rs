@@ -77,8 +77,18 @@ impl FmuModel {
         // first; the contact watch below follows every step all the same.
         let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
         let datum = self.datum.take_warning(axle_box, time);
+        // TrackContact at the axle boxes: what it knows of its partner (at every step:
+        // with vehicle.sideframe.source = auto it takes the fitted side frames here);
+        // warned of only when new or worse, so it hides nothing the others hold.
+        let partner = match (&mut self.partner, &mut self.engine) {
+            (Some(p), Engine::Sim(sim)) => p.warning(sim, time, self.last_step),
+            _ => None,
+        };
         let other = self.track_warning(time, at_stop);
-        datum.map(|w| StepWarning::once("input datum", w)).or(other)
+        datum
+            .map(|w| StepWarning::once("input datum", w))
+            .or(partner)
+            .or(other)
     }
 
     /// [`FmuModel::warning_after_step`] for the units that carry the track: the contact
