@@ -360,7 +360,7 @@ impl SprungBody for CarriedFrames {
 /// per wheel) under the static wheel loads `static_load` `[left, right]` (N), and above
 /// them the side frames of `inertia`, spanning two wheelsets' axle boxes when `shared`.
 /// The partner is taken as those side frames alone, moved exactly under the forces it
-/// holds over a step ([`CarriedFrames`]): its secondary suspension and the bodies above
+/// holds over a step (`CarriedFrames`): its secondary suspension and the bodies above
 /// are slow beside the exchange's fast modes, and its integrator is its own. `None` with
 /// nothing carried ([`SideFrameInertia::NONE`]: the partner's bodies there are unknown).
 ///
