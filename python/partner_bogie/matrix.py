@@ -90,10 +90,15 @@ CELL_TIMEOUT = 300
 # The cells and their systems.
 
 
-def cell(master, step, output, scale=1.0, partner="standin", stop=STOP):
+def cell(master, step, output, scale=1.0, partner="standin", stop=STOP, track=None):
     """A cell of the matrix: `partner` "standin" (the pythonfmu stand-in, side frames
-    scaled by `scale`) or "wagon" (this project's Wagon FMU, scale 1)."""
-    return dict(partner=partner, master=master, step=step, scale=scale, output=output, stop=stop)
+    scaled by `scale`) or "wagon" (this project's Wagon FMU, scale 1); `track`,
+    TrackContact's parameters set apart from the shipped system's ({name: value}, an
+    int for an Integer or Enumeration)."""
+    c = dict(partner=partner, master=master, step=step, scale=scale, output=output, stop=stop)
+    if track:
+        c["track"] = dict(track)
+    return c
 
 
 def label(c):
@@ -177,6 +182,8 @@ def system_of(c, standin_fmu=None):
         track["wheelset[2].offset"] = ("Real", p["wheelbase"])
         track["static_load.left"] = ("Real", load)
         track["static_load.right"] = ("Real", load)
+    for name, value in c.get("track", {}).items():
+        track[name] = ("Integer" if isinstance(value, int) else "Real", value)
     primary = wf.every_wheelset(n, tuple(f"primary.{s}.{c['output']}" for s in ("left", "right")))
     connections = [(partner[0], o, "TrackContact", f) for o, f in zip(outputs, frames)]
     connections += [("TrackContact", p, partner[0], i) for p, i in zip(primary, inputs)]
@@ -589,12 +596,12 @@ def run_cell(c, standin_fmu=None, keep_log=False, fmu_dir=None):
         error = max(abs(e) for e in errors)
     failure = r.get("failure")
     diverged = bool(failure) or error is None or error > DIVERGED
-    warnings = [m[:100] for s, m in track_msgs if s == "warning"]
+    warnings = [m for s, m in track_msgs if s == "warning"]
     res = dict(cell=c, error=error, errors=errors, peaks=peaks, reference=list(ref), diverged=diverged,
                failure=failure, time=r.get("time"), warnings=warnings,
                warning_kinds=sorted({_kind(m) for s, m in track_msgs if s == "warning"}),
                track_statuses=track_statuses, statuses_known=r.get("statuses_known", False),
-               warned=bool(warnings), partner_warnings=[m[:100] for s, m in partner_msgs if s == "warning"],
+               warned=bool(warnings), partner_warnings=[m for s, m in partner_msgs if s == "warning"],
                wall=time.perf_counter() - t0)
     res["rule_broken"] = rule_broken(res)
     if keep_log:

@@ -85,9 +85,9 @@ impl HeldForce {
 /// Least-squares sums `[x x, x y, y y]` of one channel and candidate.
 type Sums = [f64; 3];
 
-/// Least-squares sums of the bounce channel: `r r^T` of `r = [x, u, w, y]`, the
-/// candidate's impulse, the side frame's velocity and displacement changes (times the
-/// step), and the velocity change fitted.
+/// Least-squares sums of the bounce channel: `r r^T` of `r = [x, u, w, y]`: the
+/// candidate's impulse (first differences, as all), the secondary suspension's two
+/// regressors, and the velocity change fitted.
 type BounceSums = nalgebra::Matrix4<f64>;
 
 /// The fit of the side frames' inertia and of the held force; see the module.
@@ -181,7 +181,7 @@ impl PartnerFit {
             Some(p) if h > 0.0 => vec![p.clone(), (z.to_vec(), v.to_vec())],
             _ => vec![(z.to_vec(), v.to_vec())],
         };
-        let ([older, newer], [(z0, v0), (_, v1)]) = (&self.history[..], &before[..]) else {
+        let ([older, newer], [(z0, _), (z1, v1)]) = (&self.history[..], &before[..]) else {
             self.last_bounce = None;
             return;
         };
@@ -199,29 +199,46 @@ impl PartnerFit {
                 h * newer[0][i],
             ]
         };
-        // The side frame's motion over the last two steps (times the step), for what
-        // the secondary suspension adds.
-        let moved = |i: usize| (0.5 * h * (v[i] - v0[i]), 0.5 * h * (z[i] - z0[i]));
+        // What the secondary suspension adds to the impulse of a step, from the side
+        // frame's displacements (its other end, the bolster, slow): a damper's impulse is
+        // `-C_2` times the displacement over the step, exactly, so its first difference
+        // is `-C_2` times the displacement's second difference; a spring's is `-K_2`
+        // times the displacement's integral, `h (z_k + z_(k-1)) / 2` by the trapezoid, so
+        // its first difference is `-K_2 h (z_k - z_(k-2)) / 2`.
+        let moved = |i: usize| (z[i] - 2.0 * z1[i] + z0[i], 0.5 * h * (z[i] - z0[i]));
+        // The bounce of both sides' side frames together: the bolster between them rolls
+        // fast on its secondary springs (31 Hz with the half-car's) and carries one
+        // side's secondary force to the other, but its bounce, under the car body, is
+        // slow. Pitch side frame by side frame.
         let mut bounce = Vec::new();
         let mut motion = Vec::new();
+        let span = if self.shared { 4 } else { 2 };
+        for group in 0..self.boxes / span {
+            let boxes = (span * group)..(span * (group + 1));
+            let mut x = [0.0; 4];
+            let (mut y, mut u, mut w) = (0.0, 0.0, 0.0);
+            for i in boxes {
+                let (xi, (ui, wi)) = (held(i), moved(i));
+                for c in 0..4 {
+                    x[c] += xi[c];
+                }
+                y += dv[i];
+                u += ui;
+                w += wi;
+            }
+            bounce.push((y, x));
+            motion.push((u, w));
+        }
         if self.shared {
             for bogie in 0..self.boxes / 4 {
                 for side in 0..2 {
                     let (a, b) = (4 * bogie + side, 4 * bogie + 2 + side);
                     let (xa, xb) = (held(a), held(b));
-                    bounce.push((dv[a] + dv[b], [0, 1, 2, 3].map(|c| xa[c] + xb[c])));
-                    let ((ua, wa), (ub, wb)) = (moved(a), moved(b));
-                    motion.push((ua + ub, wa + wb));
                     let y = dv[a] - dv[b];
                     for c in 0..4 {
                         add(&mut self.pitch[c], xa[c] - xb[c], y);
                     }
                 }
-            }
-        } else {
-            for (i, &d) in dv.iter().enumerate() {
-                bounce.push((d, held(i)));
-                motion.push(moved(i));
             }
         }
         if let Some(before) = self.last_bounce.replace(bounce.clone()) {
@@ -254,13 +271,12 @@ impl PartnerFit {
         }
         // What each candidate leaves, over both channels, as a share of the motion, and
         // its bounce coefficients.
+        // What each candidate leaves, over both channels, as a share of the motion, and
+        // its bounce coefficient.
         let fits: Vec<Option<(f64, f64)>> = (0..4)
             .map(|c| {
                 let m = &self.bounce[c];
-                let a = m.fixed_view::<3, 3>(0, 0).into_owned();
-                let b = m.fixed_view::<3, 1>(0, 3).into_owned();
-                let coef = a.cholesky()?.solve(&b);
-                let mut left = m[(3, 3)] - b.dot(&coef);
+                let (mut left, coef) = least_squares(m)?;
                 let mut total = m[(3, 3)];
                 if self.shared {
                     let [xx, xy, yy] = self.pitch[c];
@@ -296,6 +312,21 @@ impl PartnerFit {
             residual,
         })
     }
+}
+
+/// The least-squares fit of the last value of the sums `m` (`y`) on the others, scaled
+/// to a unit diagonal first (their units differ by orders of magnitude: N s, m, m s):
+/// what it leaves of `y y`, and the coefficients. `None` where the regressors are not
+/// independent.
+fn least_squares(m: &BounceSums) -> Option<(f64, nalgebra::Vector3<f64>)> {
+    let a = m.fixed_view::<3, 3>(0, 0).into_owned();
+    let b = m.fixed_view::<3, 1>(0, 3).into_owned();
+    let d = a
+        .diagonal()
+        .map(|x| if x > 0.0 { 1.0 / x.sqrt() } else { 0.0 });
+    let scale = nalgebra::Matrix3::from_diagonal(&d);
+    let coef = scale * (scale * a * scale).cholesky()?.solve(&(scale * b));
+    Some((m[(3, 3)] - b.dot(&coef), coef))
 }
 
 /// Adds a sample `(x, y)` to the sums.

@@ -14,7 +14,9 @@ mod warnings;
 mod watch;
 
 pub use parameters::{scenario, track_params, vehicle_params, vehicle_unit_params};
-pub use partner::{COPY_TOLERANCE, FIT_STEP_RADIANS, JUMP_TOLERANCE};
+pub use partner::{
+    COPY_TOLERANCE, FIT_STEP_RADIANS, JACOBI_ACCURATE, JUMP_TOLERANCE, MASS_TOLERANCE,
+};
 pub use unit::FmuModel;
 pub use warnings::END_ZONE_SPANS;
 
