@@ -474,7 +474,11 @@ def reference(partner, scale=1.0, stop=STOP, fmu_dir=None):
 
 # Short names of TrackContact's warnings, by a phrase of their text; others are named
 # by their first words.
-KINDS = (("struck the rail", "exchange bounces"), ("inputs.datum", "input datum"))
+KINDS = (("struck the rail", "exchange bounces"), ("inputs.datum", "input datum"),
+         ("side frames, fitted from the exchange", "side-frame copy"),
+         ("the bogie holds primary", "output choice"),
+         ("estimated from what TrackContact carries", "axle-box step"),
+         ("primary forces jumped", "axle-box jump"))
 
 
 def _kind(message):
@@ -508,7 +512,7 @@ def _libcosim_log(log, partner):
         if not m:
             continue
         status, text = m.group(2), m.group(3)
-        mine = partner == "standin" or not VEHICLE_WARNING.search(text)
+        mine = partner == "standin" or not VEHICLE_WARNING.search(text) or "what TrackContact carries" in text
         (track if mine else other).append((status, text))
     return track, other
 

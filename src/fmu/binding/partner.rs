@@ -24,9 +24,10 @@ pub const COPY_TOLERANCE: f64 = 0.10;
 /// bounce cannot be told apart from bodies that move fast above the side frames: the
 /// exchange sees the side frame and what moves with it. Measured at 1 ms against the
 /// side frames' own masses: the stand-in bogie (RK4, its bolster under the car body)
-/// within 0.2 %; this project's half-car bogie -4 % (its central differences); the
-/// roll-plane vehicle +26 % (its 232.5 kg bolster, which carries the car body's weight
-/// but not its mass, bounces at 23 Hz on the secondary springs, beside the side frames).
+/// within 1 %; this project's half-car bogie -3.5 % (its central differences); the
+/// roll-plane vehicle +15 % (+1 % at 2 ms, +12 % at 4 ms: its 232.5 kg bolster, which
+/// carries the car body's weight but not its mass, bounces on the secondary springs
+/// beside the side frames).
 pub const MASS_TOLERANCE: f64 = 0.35;
 
 /// The side frames are fitted (checked, or taken with `auto`) at communication steps
