@@ -325,6 +325,14 @@ impl Model for FmuModel {
         self.warning_after_step(time, at_stop)
     }
 
+    /// TrackContact at the axle boxes: the fitted side frames taken
+    /// (`vehicle.sideframe.source = auto`).
+    fn take_events(&mut self) -> Vec<String> {
+        self.partner
+            .as_mut()
+            .map_or_else(Vec::new, |p| p.take_events())
+    }
+
     /// The engine's state, then TrackContact's input datum.
     fn state_vector(&self) -> Result<Vec<f64>, Error> {
         let mut v = match &self.engine {

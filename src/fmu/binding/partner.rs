@@ -73,6 +73,8 @@ pub(super) struct PartnerWatch {
     warned: Vec<(&'static str, f64)>,
     /// Communication steps taken.
     steps: u64,
+    /// What it did of its own accord since last asked (the fitted side frames taken).
+    events: Vec<String>,
 }
 
 /// Communication steps the step's warning waits for the fit to tell the master's kind
@@ -132,6 +134,7 @@ impl PartnerWatch {
             jump: 0.0,
             warned: Vec::new(),
             steps: 0,
+            events: Vec::new(),
         };
         w.after_step(sim);
         Ok(Some(w))
@@ -170,6 +173,11 @@ impl PartnerWatch {
         }
         self.fit.forces_at_point(&point, &mean);
         self.point = point;
+    }
+
+    /// What it did of its own accord since last asked.
+    pub fn take_events(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.events)
     }
 
     /// A state restored: the fit forgets the last point, its sums stay.
@@ -233,7 +241,7 @@ impl PartnerWatch {
                 return Some(StepWarning::worse(
                     "side-frame copy",
                     severity,
-                    self.copy_message(time, e.mass, e.pitch_inertia, off_mass.max(off_pitch)),
+                    self.copy_message(time, e.mass, e.pitch_inertia),
                 ));
             }
         }
@@ -269,12 +277,13 @@ impl PartnerWatch {
                      load) when the side frames' motion came in: the bogie's side frames \
                      moved over the communication step {} s otherwise than those TrackContact \
                      carries, so the exchange's forces are off by as much (more than {:.0} % \
-                     of the static load); a shorter step, or the side frames set as the \
-                     partner's (vehicle.sideframe.*, or vehicle.sideframe.source = auto), \
-                     brings it down",
-                    num(jump),
+                     of the static load). Likely causes: the step (try half of it), side \
+                     frames carried that are not the partner's (vehicle.sideframe.*), or a \
+                     Jacobi master handing on primary.*.mean_force (read primary.*.force); \
+                     TrackContact names the one it finds once the exchange shows it",
+                    sig(jump),
                     100.0 * jump / load,
-                    num(h),
+                    sig(h),
                     100.0 * JUMP_TOLERANCE
                 ),
             ));
@@ -293,6 +302,17 @@ impl PartnerWatch {
         // Fitted values outside what the links take are not taken (the warning of the
         // copy stays as it was).
         if sim.set_side_frame_inertia(inertia).is_ok() {
+            let per_box = if j.is_some() { 0.5 * mass } else { mass };
+            self.events.push(format!(
+                "vehicle.sideframe.source = auto: at t = {} s took the partner's side frames as \
+                 fitted from the exchange: vehicle.sideframe.mass = {} kg per axle box{}",
+                sim.time(),
+                sig(per_box),
+                j.map_or(String::new(), |j| format!(
+                    ", vehicle.sideframe.pitch_inertia = {} kg m^2",
+                    sig(j)
+                ))
+            ));
             self.mass = mass;
             self.pitch_inertia = j;
             self.adopted = true;
@@ -311,35 +331,44 @@ impl PartnerWatch {
         }
     }
 
-    fn copy_message(&self, time: f64, mass: f64, pitch: Option<f64>, off: f64) -> String {
+    fn copy_message(&self, time: f64, mass: f64, pitch: Option<f64>) -> String {
         let (per_box, set_mass) = match self.pitch_inertia {
             // Over two wheelsets vehicle.sideframe.mass is half a side frame.
             Some(_) => (0.5 * self.mass, 0.5 * mass),
             None => (self.mass, mass),
         };
-        let mut carried = format!("vehicle.sideframe.mass = {} kg per axle box", num(per_box));
-        let mut set = format!("vehicle.sideframe.mass = {} kg", num(set_mass));
-        let mut fitted = format!("{} kg", num(mass));
+        // How far each carried value is from the partner's, as a share of the partner's.
+        let off = |carried: f64, fitted: f64| format!("{:+.0} %", 100.0 * (carried / fitted - 1.0));
+        let mut carried = format!(
+            "vehicle.sideframe.mass = {} kg per axle box ({} against the partner's)",
+            num(per_box),
+            off(self.mass, mass)
+        );
+        let mut set = format!("vehicle.sideframe.mass = {} kg", sig(set_mass));
+        let mut fitted = format!("{} kg", sig(mass));
         if let (Some(c), Some(f)) = (self.pitch_inertia, pitch) {
-            carried.push_str(&format!(
-                " (a side frame of {} kg) and vehicle.sideframe.pitch_inertia = {} kg m^2",
+            carried = format!(
+                "vehicle.sideframe.mass = {} kg per axle box (a side frame of {} kg, {}) and \
+                 vehicle.sideframe.pitch_inertia = {} kg m^2 ({})",
+                num(per_box),
                 num(self.mass),
-                num(c)
-            ));
+                off(self.mass, mass),
+                num(c),
+                off(c, f)
+            );
             set.push_str(&format!(
                 " (per axle box) and vehicle.sideframe.pitch_inertia = {} kg m^2",
-                num(f)
+                sig(f)
             ));
-            fitted = format!("{} kg and {} kg m^2 per side frame", num(mass), num(f));
+            fitted = format!("{} kg and {} kg m^2 per side frame", sig(mass), sig(f));
         }
         format!(
             "at t = {time} s the partner's side frames, fitted from the exchange (their \
              velocities against the primary forces they held), are {fitted}; TrackContact \
-             carries {carried}, {:.0} % off: over each communication step it moves side \
-             frames that are not the partner's, which moves the peaks (-2 % at 1 ms, +8 % at \
-             16 ms with half of them) and the stable step; set {set}, or vehicle.sideframe.\
-             source = auto to take the fitted ones",
-            100.0 * off
+             carries {carried}: over each communication step it moves side frames that are \
+             not the partner's, which moves the peaks and the stable step (lighter side \
+             frames lower it: mind the step warning that follows); set {set}, or \
+             vehicle.sideframe.source = auto to take the fitted ones"
         )
     }
 
@@ -374,10 +403,10 @@ impl PartnerWatch {
              TrackContact carries (the wheelsets on the contact, the primary suspension \
              vehicle.primary.*, the side frames vehicle.sideframe.*): {what}; use steps of at \
              most {} s",
-            num(h),
+            sig(h),
             if h > limit { "above" } else { "near" },
-            num(limit),
-            num(most)
+            sig(limit),
+            sig(most)
         )
     }
 }
@@ -404,4 +433,13 @@ fn output_message(time: f64, held: HeldForce, residual: f64) -> String {
              inputs instead"
         ),
     }
+}
+
+/// `x` to four significant digits, as a person reads a fitted value.
+fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
 }

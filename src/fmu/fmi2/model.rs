@@ -172,6 +172,12 @@ pub trait Model: Clone + Sized {
     /// while it holds, `fmi2OK` and nothing logged.
     fn step_warning(&mut self, time: f64, at_stop: bool) -> Option<StepWarning>;
 
+    /// What the model did of its own accord in the last step that a user may want to
+    /// know (logged in the category `logEvents` when debug logging is on; no status).
+    fn take_events(&mut self) -> Vec<String> {
+        Vec::new()
+    }
+
     /// Everything that determines the continuation, for serialized FMU states.
     fn state_vector(&self) -> Result<Vec<f64>, Error>;
 

@@ -111,6 +111,10 @@ impl<M: Model> Instance<M> {
             .model
             .as_mut()
             .and_then(|m| m.step_warning(end, at_stop));
+        let events = self.model.as_mut().map(|m| m.take_events());
+        for e in events.into_iter().flatten() {
+            self.log_event(|| e);
+        }
         if let Some(w) = warning {
             // FMI 2.0.5 (2.1.3): fmi2Warning says "things are not quite right, but the
             // computation can continue", with the logger called (FMI 3.0: "a non-critical
