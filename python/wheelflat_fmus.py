@@ -484,7 +484,7 @@ def run_wagon(paths, stop_time, track_params=None, wagon_params=None, record=Non
 
 
 def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_params=None, vehicle_params=None,
-                         record=None, jacobi=False, primary_output="mean_force"):
+                         record=None, jacobi=False, primary_output="mean_force", steps=None, velocities=True):
     """Couples TrackContact (`n` wheelsets) and the vehicle FMU `model` at the axle
     boxes (``interface`` = axle_box): the track carries every wheelset with its primary
     suspension, the vehicle the bodies above. Per communication step the side frames'
@@ -493,9 +493,11 @@ def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_param
     communication point, as OSP libcosim and ecos do, the vehicle given the forces of
     the point before the track steps. ``primary_output``: the track's output handed to
     the vehicle, ``mean_force`` (for a sequential master) or ``force`` (for a Jacobi
-    one). Returns the largest contact forces ``[[left, right] of each wheelset]`` (N)
-    over the run; ``record``, a list, receives ``[time, the contact forces]`` at every
-    communication point."""
+    one). ``steps``: the communication steps (s) one by one instead of ``comm_step`` to
+    ``stop_time``; ``velocities`` False hands the track the side frames' displacements
+    only (a partner that leaves ``sideframe.*.v`` unset). Returns the largest contact
+    forces ``[[left, right] of each wheelset]`` (N) over the run; ``record``, a list,
+    receives ``[time, the contact forces]`` at every communication point."""
     track = Unit(paths["TrackContact"], "track")
     vehicle = Unit(paths[model], "vehicle")
     frames = every_wheelset(n, FRAMES)
@@ -510,18 +512,22 @@ def run_carrier_axle_box(paths, model, n, stop_time, comm_step=1e-3, track_param
                           dict(vehicle_params or {}, interface=2))
         vehicle.fmu.exitInitializationMode()
         track.fmu.exitInitializationMode()
-        steps = int(round(stop_time / comm_step))
-        for k in range(steps):
-            t = k * comm_step
+        if steps is None:
+            steps = [comm_step] * int(round(stop_time / comm_step))
+        if not velocities:
+            frames = [f for f in frames if f.endswith(".z")]
+        t = 0.0
+        for h in steps:
             if jacobi:  # both units' outputs of this point, before either gets an input
                 vehicle.set(axle_box, track.get(*primary))
             track.set(frames, vehicle.get(*frames))
-            track.fmu.doStep(t, comm_step)
+            track.fmu.doStep(t, h)
             if not jacobi:
                 vehicle.set(axle_box, track.get(*primary))
-            vehicle.fmu.doStep(t, comm_step)
+            vehicle.fmu.doStep(t, h)
+            t += h
             if record is not None:
-                record.append([t + comm_step] + track.get(*forces))
+                record.append([t] + track.get(*forces))
         m = track.get(*every_wheelset(n, ("contact.left.max_force", "contact.right.max_force")))
         return [m[2 * i:2 * i + 2] for i in range(n)]
     finally:

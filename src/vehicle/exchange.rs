@@ -245,13 +245,24 @@ fn amplification<B: SprungBody>(
     a
 }
 
-/// Spectral radius of `a`.
+/// Spectral radius of `a`, through its real Schur form with a bounded number of QR
+/// iterations: nalgebra's `complex_eigenvalues` iterates without bound and spun forever
+/// on some of these matrices (dimforge/nalgebra#1291). A form that does not converge
+/// counts as unstable (infinite), so the scan stops below it: the estimate errs low.
 fn spectral_radius(a: &DMatrix<f64>) -> f64 {
-    a.complex_eigenvalues()
-        .iter()
-        .map(|z| z.norm())
-        .fold(0.0, f64::max)
+    match nalgebra::linalg::Schur::try_new(a.clone(), f64::EPSILON, SCHUR_ITERATIONS) {
+        Some(schur) => schur
+            .complex_eigenvalues()
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max),
+        None => f64::INFINITY,
+    }
 }
+
+/// The most QR iterations of one Schur decomposition in [`spectral_radius`]: a few per
+/// eigenvalue converge (the matrices here are about 30 by 30).
+const SCHUR_ITERATIONS: usize = 5_000;
 
 /// The largest `h` of a geometric scan from 0.05 ms (ratio 1.1, up to 20 ms) below
 /// which every step keeps the spectral radius at most 1 (to 1e-9).

@@ -108,6 +108,8 @@ pub struct PartnerFit {
     /// The bounce channels of the last step, `(y, x per candidate)`, for the first
     /// differences.
     last_bounce: Option<Vec<(f64, [f64; 4])>>,
+    /// The step of the last bounce sample (s): first differences need equal steps.
+    last_h: f64,
     /// Sums of the bounce channel per candidate, over every side frame (all alike).
     bounce: [BounceSums; 4],
     /// Sums of the pitch channel per candidate.
@@ -149,6 +151,7 @@ impl PartnerFit {
             history: Vec::new(),
             last: Vec::new(),
             last_bounce: None,
+            last_h: 0.0,
             bounce: [BounceSums::zeros(); 4],
             pitch: [[0.0; 3]; 4],
             steps: 0,
@@ -241,7 +244,11 @@ impl PartnerFit {
                 }
             }
         }
-        if let Some(before) = self.last_bounce.replace(bounce.clone()) {
+        // First differences over steps of one length only: over unequal ones the static
+        // load times the change of step, unseen, would dominate them.
+        let same = (h - std::mem::replace(&mut self.last_h, h)).abs() <= 1e-9 * h;
+        let before = self.last_bounce.replace(bounce.clone()).filter(|_| same);
+        if let Some(before) = before {
             for (((y, x), (y0, x0)), (u, w)) in bounce.iter().zip(&before).zip(&motion) {
                 for c in 0..4 {
                     let r = nalgebra::Vector4::new(x[c] - x0[c], *u, *w, y - y0);

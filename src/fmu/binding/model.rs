@@ -168,10 +168,13 @@ impl Model for FmuModel {
                     enums::side_frame_source::Item::Configured => false,
                     enums::side_frame_source::Item::Auto => true,
                 };
-                PartnerWatch::new(sim, auto)?
+                (PartnerWatch::new(sim, auto)?, auto)
             }
-            _ => None,
+            _ => (None, false),
         };
+        // vehicle.sideframe.source = auto with nothing to fit: said at initialisation.
+        let unused_auto = partner.1 && partner.0.is_none();
+        let partner = partner.0;
         let spans = values[vr::TRACK_SPANS as usize];
         let default_spans = table.var(vr::TRACK_SPANS).map(|v| v.start);
         let unused_spans = match &engine {
@@ -189,6 +192,7 @@ impl Model for FmuModel {
             datum,
             watch,
             partner,
+            unused_auto,
             master_end: 0.0,
             started: false,
             off_grid_steps: 0,
@@ -246,8 +250,16 @@ impl Model for FmuModel {
                  gives the fixed track of track.spans spans"
             )
         });
+        let auto = self.unused_auto.then(|| {
+            "vehicle.sideframe.source = auto is not used: TrackContact fits side frames only \
+             at the axle boxes (interface = axle_box) under the side frames it carries \
+             (vehicle.model = roll_plane, half_car or wagon; nothing with two_axle)"
+                .to_string()
+        });
         // The fixed track's stop time and the endless track's spans never meet.
-        spans.or_else(|| self.unreachable_stop(start, stop))
+        spans
+            .or(auto)
+            .or_else(|| self.unreachable_stop(start, stop))
     }
 
     /// The track-carrying FMUs step on their fixed grid `t_k = k solver.step` and stop

@@ -75,7 +75,24 @@ pub(super) struct PartnerWatch {
     steps: u64,
     /// What it did of its own accord since last asked (the fitted side frames taken).
     events: Vec<String>,
+    /// The side frames handed on at the last point (m, m/s), and the points in a row at
+    /// which their displacements moved while their velocities stayed as they were.
+    last_frames: Option<(Vec<f64>, Vec<f64>)>,
+    still_velocities: u32,
+    /// The primary forces at rest (N per box) and their largest departure from it so far,
+    /// as a share of the static load: whether an impact has run before auto took the
+    /// fitted side frames.
+    rest: Vec<f64>,
+    departure: f64,
 }
+
+/// Points in a row at which the side frames' displacements move and their velocities do
+/// not, before TrackContact warns that the velocities are not handed on.
+const STILL_VELOCITY_POINTS: u32 = 10;
+
+/// The departure of the primary forces from rest (a share of the static load) past which
+/// an impact has run: auto's fitted side frames taken after it come too late for it.
+const IMPACT_DEPARTURE: f64 = 0.5;
 
 /// Communication steps the step's warning waits for the fit to tell the master's kind
 /// (it decides after 20 to 25 with the reference flat); then, still unknown, the Jacobi
@@ -135,8 +152,13 @@ impl PartnerWatch {
             warned: Vec::new(),
             steps: 0,
             events: Vec::new(),
+            last_frames: None,
+            still_velocities: 0,
+            rest: Vec::new(),
+            departure: 0.0,
         };
         w.after_step(sim);
+        w.rest = w.point.clone();
         Ok(Some(w))
     }
 
@@ -158,6 +180,17 @@ impl PartnerWatch {
                 self.jump = self.jump.max((a - b).abs());
             }
         }
+        if let Some((z0, v0)) = self.last_frames.replace((z.clone(), v.clone()))
+            && h > 0.0
+        {
+            let moved = z.iter().zip(&z0).any(|(a, b)| (a - b).abs() > 1e-9);
+            let still = v == v0;
+            self.still_velocities = if moved && still {
+                self.still_velocities + 1
+            } else {
+                0
+            };
+        }
         self.fit.side_frames_given(h, &z, &v);
     }
 
@@ -172,6 +205,10 @@ impl PartnerWatch {
             }
         }
         self.fit.forces_at_point(&point, &mean);
+        let load = self.static_load[0].max(self.static_load[1]);
+        for (p, r) in point.iter().zip(&self.rest) {
+            self.departure = self.departure.max((p - r).abs() / load);
+        }
         self.point = point;
     }
 
@@ -207,6 +244,22 @@ impl PartnerWatch {
     /// beyond the stable one, the exchange's jump.
     pub fn warning(&mut self, sim: &mut Simulation, time: f64, h: f64) -> Option<StepWarning> {
         self.steps += 1;
+        if self.still_velocities >= STILL_VELOCITY_POINTS
+            && self.fresh("side-frame velocities", 1.0)
+        {
+            return Some(StepWarning::once(
+                "side-frame velocities",
+                format!(
+                    "at t = {time} s the side frames' velocities sideframe.*.v have stayed as \
+                     they were for {STILL_VELOCITY_POINTS} communication points while their \
+                     displacements sideframe.*.z moved: TrackContact moves the side frames on \
+                     over each step from the velocities handed on and computes the primary \
+                     dampers' forces from them, so velocities left unset (or held) give wrong \
+                     forces; connect the bogie's side-frame velocities (m/s, up) to \
+                     sideframe.*.v"
+                ),
+            ));
+        }
         let estimate = self.fit.estimate();
         let held = estimate.map(|e| e.held);
         if let Some(e) = estimate
@@ -219,6 +272,33 @@ impl PartnerWatch {
             ));
         }
         if let Some(e) = estimate.filter(|_| h * self.omega <= FIT_STEP_RADIANS) {
+            // Side frames outside every physical range: not the partner's, the inputs.
+            let per_box = if self.pitch_inertia.is_some() {
+                0.5 * e.mass
+            } else {
+                e.mass
+            };
+            let physical = crate::limits::check("vehicle.sideframe.mass", per_box).is_ok()
+                && e.pitch_inertia.is_none_or(|j| {
+                    crate::limits::check("vehicle.sideframe.pitch_inertia", j).is_ok()
+                });
+            if !physical {
+                return self.fresh("side-frame units", 1.0).then(|| {
+                    StepWarning::once(
+                        "side-frame units",
+                        format!(
+                            "at t = {time} s the side-frame motion handed on, fitted against the \
+                             primary forces the bogie held, gives side frames of {} kg{}: \
+                             outside the range of vehicle.sideframe.*, so not a bogie's; check \
+                             that sideframe.*.z are the side frames' displacements in m and \
+                             sideframe.*.v their velocities in m/s, both up",
+                            sig(e.mass),
+                            e.pitch_inertia
+                                .map_or(String::new(), |j| format!(" and {} kg m^2", sig(j)))
+                        ),
+                    )
+                });
+            }
             let pitch = e.pitch_inertia.zip(self.pitch_inertia);
             let off_mass = (e.mass / self.mass - 1.0).abs();
             let off_pitch = pitch.map_or(0.0, |(f, c)| (f / c - 1.0).abs());
@@ -235,13 +315,31 @@ impl PartnerWatch {
                 };
                 let moved = (mass / self.mass - 1.0).abs() > 0.02 || off_pitch > 0.02;
                 if !self.adopted || moved {
+                    // Side frames beyond the tolerances taken after an impact: it ran with
+                    // the configured ones.
+                    let late = severity > 1.0 && self.departure > IMPACT_DEPARTURE;
+                    let before = self.copy_message(time, e.mass, e.pitch_inertia);
                     self.adopt(sim, mass, e.pitch_inertia);
+                    if late && self.fresh("side frames taken late", 1.0) {
+                        return Some(StepWarning::once(
+                            "side frames taken late",
+                            format!(
+                                "vehicle.sideframe.source = auto took the partner's side frames \
+                                 only after an impact had run with the configured ones (the fit \
+                                 decides about 25 communication steps after the motion starts), \
+                                 so that impact's forces are off: {before}"
+                            ),
+                        ));
+                    }
                 }
             } else if severity > 1.0 && self.fresh("side-frame copy", severity) {
                 return Some(StepWarning::worse(
                     "side-frame copy",
                     severity,
-                    self.copy_message(time, e.mass, e.pitch_inertia),
+                    format!(
+                        "{}, or vehicle.sideframe.source = auto to take the fitted ones",
+                        self.copy_message(time, e.mass, e.pitch_inertia)
+                    ),
                 ));
             }
         }
@@ -261,7 +359,7 @@ impl PartnerWatch {
                 return Some(StepWarning::worse(
                     "axle-box step",
                     h / most,
-                    self.step_message(time, h, limit, most, held),
+                    self.step_message(time, h, (limit, most, l.sequential), held),
                 ));
             }
         }
@@ -331,6 +429,8 @@ impl PartnerWatch {
         }
     }
 
+    /// The copy of the side frames against the fitted `mass` (kg) and `pitch` (kg m^2):
+    /// what is carried, how far off, and the values beyond their tolerances to set.
     fn copy_message(&self, time: f64, mass: f64, pitch: Option<f64>) -> String {
         let (per_box, set_mass) = match self.pitch_inertia {
             // Over two wheelsets vehicle.sideframe.mass is half a side frame.
@@ -344,8 +444,14 @@ impl PartnerWatch {
             num(per_box),
             off(self.mass, mass)
         );
-        let mut set = format!("vehicle.sideframe.mass = {} kg", sig(set_mass));
         let mut fitted = format!("{} kg", sig(mass));
+        let mut set = Vec::new();
+        if (mass / self.mass - 1.0).abs() > MASS_TOLERANCE {
+            set.push(format!(
+                "vehicle.sideframe.mass = {} kg (per axle box)",
+                sig(set_mass)
+            ));
+        }
         if let (Some(c), Some(f)) = (self.pitch_inertia, pitch) {
             carried = format!(
                 "vehicle.sideframe.mass = {} kg per axle box (a side frame of {} kg, {}) and \
@@ -356,28 +462,34 @@ impl PartnerWatch {
                 num(c),
                 off(c, f)
             );
-            set.push_str(&format!(
-                " (per axle box) and vehicle.sideframe.pitch_inertia = {} kg m^2",
-                sig(f)
-            ));
             fitted = format!("{} kg and {} kg m^2 per side frame", sig(mass), sig(f));
+            if (f / c - 1.0).abs() > COPY_TOLERANCE {
+                set.push(format!(
+                    "vehicle.sideframe.pitch_inertia = {} kg m^2 (unless your bogie's wheelbase \
+                     is not wheelset[2].offset = {} m: the pitch inertia fitted scales with \
+                     its square, so set that instead)",
+                    sig(f),
+                    num(self.wheelbase)
+                ));
+            }
         }
         format!(
             "at t = {time} s the partner's side frames, fitted from the exchange (their \
              velocities against the primary forces they held), are {fitted}; TrackContact \
              carries {carried}: over each communication step it moves side frames that are \
              not the partner's, which moves the peaks and the stable step (lighter side \
-             frames lower it: mind the step warning that follows); set {set}, or \
-             vehicle.sideframe.source = auto to take the fitted ones"
+             frames lower it: mind the step warning that follows); set {}",
+            set.join(" and ")
         )
     }
 
+    /// The step `h` (s) against `limit`, the stable step of the master seen (s), `most`,
+    /// the step warned above (s), and `sequential`, a sequential master's stable step.
     fn step_message(
         &self,
         time: f64,
         h: f64,
-        limit: f64,
-        most: f64,
+        (limit, most, sequential): (f64, f64, f64),
         held: Option<HeldForce>,
     ) -> String {
         let master = match held {
@@ -386,8 +498,8 @@ impl PartnerWatch {
             }
             Some(_) => "a sequential master (TrackContact first), as the exchange shows",
             None => {
-                "a Jacobi master (every unit from the same point: OSP libcosim, ecos; the \
-                 exchange has not shown the master's kind in 40 steps)"
+                "a Jacobi master (every unit from the same point: OSP libcosim, ecos), if it \
+                 is one: the exchange has not shown the master's kind in 40 steps"
             }
         };
         let what = if h > limit {
@@ -397,12 +509,21 @@ impl PartnerWatch {
              peaks passes 1 % (the stand-in bogie of tests/test_partner_bogie.py: 1.15 % at \
              1.1 times three quarters)"
         };
+        let other = if held.is_none() {
+            format!(
+                " (under a sequential master that steps TrackContact first and hands the bogie \
+                 primary.*.mean_force the stable step is {} s)",
+                sig(sequential)
+            )
+        } else {
+            String::new()
+        };
         format!(
             "at t = {time} s the communication step {} s is {} the largest at which \
              the axle-box exchange stays stable under {master}, {} s, estimated from what \
              TrackContact carries (the wheelsets on the contact, the primary suspension \
              vehicle.primary.*, the side frames vehicle.sideframe.*): {what}; use steps of at \
-             most {} s",
+             most {} s{other}",
             sig(h),
             if h > limit { "above" } else { "near" },
             sig(limit),

@@ -38,6 +38,9 @@ pub struct FmuModel {
     pub(super) watch: ContactWatch,
     /// What TrackContact at the axle boxes knows of its partner (side frames carried).
     pub(super) partner: Option<PartnerWatch>,
+    /// `vehicle.sideframe.source = auto` set where TrackContact fits nothing, for the
+    /// warning at the end of initialisation.
+    pub(super) unused_auto: bool,
     /// The end of the master's last step, in model time (s).
     pub(super) master_end: f64,
     /// A vehicle's first step was checked against its forces at rest.
