@@ -92,7 +92,7 @@ const STILL_VELOCITY_POINTS: u32 = 10;
 
 /// The departure of the primary forces from rest (a share of the static load) past which
 /// an impact has run: auto's fitted side frames taken after it come too late for it.
-const IMPACT_DEPARTURE: f64 = 0.5;
+const IMPACT_DEPARTURE: f64 = 0.05;
 
 /// Communication steps the step's warning waits for the fit to tell the master's kind
 /// (it decides after 20 to 25 with the reference flat); then, still unknown, the Jacobi
