@@ -227,3 +227,17 @@ def test_the_quick_matrix_warns_where_the_exchange_is_off_and_only_there(standin
             allowed.add("output choice")
             assert "output choice" in kinds, (matrix.label(c), r["warnings"])
         assert kinds <= allowed, (matrix.label(c), r["errors"], r["warnings"])
+
+
+def test_trackcontact_tells_the_bogies_static_wheel_load_from_its_first_step(standin):
+    # Issue 41 (a load that does not hold the partner at rest was silent): static_load.*
+    # 1 % above the stand-in's 107,664.75 N. The side frames move off at the first step as
+    # under the difference; TrackContact names the bogie's wheel load within 0.2 %.
+    load = 1.01 * 107664.75
+    r = matrix.run_cell(matrix.cell("fmpy_jacobi", 1e-3, "force", 1.0, stop=0.05,
+                                    track={"static_load.left": load, "static_load.right": load}), standin)
+    told = [w for w in r["warnings"] if "moved off at the first step" in w]
+    assert len(told) == 1, r["warnings"]
+    import re
+    left = float(re.search(r"static wheel loads are about ([0-9.e+-]+) N left", told[0]).group(1))
+    assert left == pytest.approx(107664.75, rel=2e-3), told[0]
