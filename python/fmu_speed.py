@@ -8,7 +8,8 @@ docs/PERFORMANCE.md:
   fixed track (issue 42: machines differ, the ratios are what to quote): the thesis'
   fixed 30-span track (0.95 s, the wheel's whole run on it), the default window, the
   converged 20 m window, four wheelsets (roll-plane vehicles, and the wagon) and the
-  half-car bogie, and the wagon against one wheelset;
+  half-car bogie, and the wagon against one wheelset; the default window over 60 s
+  against over 1 s;
 - the fmpy FMU2Slave pair loop of python/couple.py, per communication step.
 
     python3 python/fmu_speed.py
@@ -83,6 +84,10 @@ def main():
     print("FMU2Slave, 0.05 s steps, best of 3 measured in turn; the ratio to the fixed track is the figure")
     for (name, _, _), w in zip(CASES, times):
         print(f"  {name}: {w * 1e3:.1f} ms a simulated second, {w / fixed:.2f} x the fixed track")
+    # The endless track's cost in run length: the default window over 1 s and over 60 s,
+    # in turn (issue 42: constant in run length).
+    short, long_ = side_by_side(paths["CoupledSystem"], [("1 s", {}, 1.0), ("60 s", {}, 60.0)])
+    print(f"  the default window over 60 s against over 1 s: {long_ / short:.2f} x a simulated second")
     one = dict(zip((c[0] for c in CASES), times))
     for window in ("default window", "converged window"):
         single = one["the default endless track, 10 m a side" if window == "default window"
