@@ -17,6 +17,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "python"))
 import wheelflat_fmus as wf  # noqa: E402
 from partner_bogie import build, matrix  # noqa: E402
+from fmu_helpers import initialised  # noqa: E402
 
 BOXES = ("1L", "1R", "2L", "2R")
 Z = [f"z_frame_{b}" for b in BOXES]
@@ -104,12 +105,8 @@ def test_its_side_frames_pitch_on_rigid_axle_boxes_at_the_closed_form_frequency(
     l2 = 0.25 * WHEELBASE ** 2
     omega = math.sqrt(2 * K1 * l2 / j)
     static = 0.25 * G * (M_ABOVE + 2 * scale * M_SIDEFRAME)
-    u = wf.Unit(standin, "standin")
+    u = initialised({"standin": standin}, "standin", params={"sideframe_scale": scale})
     try:
-        u.fmu.setupExperiment(startTime=0.0)
-        u.set_parameters({"sideframe_scale": scale})
-        u.fmu.enterInitializationMode()
-        u.fmu.exitInitializationMode()
         rest = np.array(u.get(*Z))
         theta = []
         for k in range(steps):

@@ -364,21 +364,19 @@ impl Simulation {
         &mut self,
         inertia: crate::vehicle::SideFrameInertia,
     ) -> Result<()> {
-        // Tried on a copy first: every link carries the same side frames, so one that
-        // takes them is all that takes them.
-        let Some(mut first) = self.wheelsets.iter().find_map(|w| match &w.vehicle {
-            VehicleState::AxleBox(link) => Some(link.clone()),
-            _ => None,
-        }) else {
-            return Err(Error::Unsupported(
-                "side frames of a simulation not cut at its axle boxes".into(),
-            ));
-        };
-        first.set_inertia(inertia)?;
+        // Every link carries the same side frames: the first refuses them (before any
+        // change) or none does.
+        let mut cut = false;
         for w in self.wheelsets.iter_mut() {
             if let VehicleState::AxleBox(link) = &mut w.vehicle {
                 link.set_inertia(inertia)?;
+                cut = true;
             }
+        }
+        if !cut {
+            return Err(Error::Unsupported(
+                "side frames of a simulation not cut at its axle boxes".into(),
+            ));
         }
         Ok(())
     }

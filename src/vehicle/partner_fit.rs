@@ -348,9 +348,9 @@ mod tests {
     use super::*;
 
     /// A side frame over two boxes `l` = 0.9 m from its centre (mass `m`, pitch
-    /// inertia `j`) on the half-car's secondary spring and damper (to a still bolster), its boxes driven by primary springs to
-    /// moving axle boxes, exchanged every `h` with `held`; the fit's estimate after
-    /// `t` seconds.
+    /// inertia `j`) on the half-car's secondary spring and damper (to a still bolster),
+    /// its boxes driven by primary springs to moving axle boxes, exchanged every `h`
+    /// with `held`; the fit's estimate after 0.3 s.
     fn exchange(m: f64, j: f64, held: HeldForce, h: f64) -> Option<PartnerEstimate> {
         let (k1, c1, l, k2, c2) = (6.5e6, 1e5, 0.9, 2.55e6, 4.4e4);
         let mut fit = PartnerFit::new(2, true, 2.0 * l);
@@ -385,16 +385,6 @@ mod tests {
         for k in 0..(0.3 / h) as usize {
             let (zf, vf) = frames(z, th, vz, vth);
             fit.side_frames_given(h, &[zf[0], 0.0, zf[1], 0.0], &[vf[0], 0.0, vf[1], 0.0]);
-            // The partner's held force over [t_k, t_k+1].
-            let f_held = |points: &Vec<[f64; 2]>,
-                          means: &Vec<[f64; 2]>,
-                          mean_now: [f64; 2],
-                          point_now: [f64; 2]| match held {
-                HeldForce::JacobiPoint => points[k],
-                HeldForce::JacobiMean => means[k],
-                HeldForce::SequentialMean => mean_now,
-                HeldForce::SequentialPoint => point_now,
-            };
             // The track's step: the forces along the exact motion of the step (the
             // side frames moved as monolithic here, a stand-in for the track's copy).
             let (mut s, mut sum) = ((z, th, vz, vth), [0.0; 2]);
@@ -411,7 +401,13 @@ mod tests {
                 );
             }
             let point_now = force(t + h, s.0, s.1, s.2, s.3);
-            let fh = f_held(&points, &means, sum, point_now);
+            // The partner's held force over [t_k, t_k+1].
+            let fh = match held {
+                HeldForce::JacobiPoint => points[k],
+                HeldForce::JacobiMean => means[k],
+                HeldForce::SequentialMean => sum,
+                HeldForce::SequentialPoint => point_now,
+            };
             // The partner: the side frame under the held forces and its own secondary
             // spring, in fine substeps.
             for _ in 0..sub {

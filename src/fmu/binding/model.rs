@@ -157,7 +157,8 @@ impl Model for FmuModel {
             Engine::Sim(sim) => ContactWatch::new(sim.wheelsets().len()),
             Engine::Vehicle(_) => ContactWatch::new(0),
         };
-        let partner = match &engine {
+        // vehicle.sideframe.source = auto with nothing to fit: said at initialisation.
+        let (partner, unused_auto) = match &engine {
             Engine::Sim(sim) if kind == Kind::TrackContact => {
                 // The FMI layer holds the enumeration to its items (its range, at set).
                 let auto = match enums::side_frame_source::Item::of(
@@ -168,13 +169,12 @@ impl Model for FmuModel {
                     enums::side_frame_source::Item::Configured => false,
                     enums::side_frame_source::Item::Auto => true,
                 };
-                (PartnerWatch::new(sim, auto)?, auto)
+                let partner = PartnerWatch::new(sim, auto)?;
+                let unused = auto && partner.is_none();
+                (partner, unused)
             }
             _ => (None, false),
         };
-        // vehicle.sideframe.source = auto with nothing to fit: said at initialisation.
-        let unused_auto = partner.1 && partner.0.is_none();
-        let partner = partner.0;
         let spans = values[vr::TRACK_SPANS as usize];
         let default_spans = table.var(vr::TRACK_SPANS).map(|v| v.start);
         let unused_spans = match &engine {

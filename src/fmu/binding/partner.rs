@@ -8,7 +8,7 @@
 //! partner's side-frame motion comes in.
 
 use crate::error::{Result, num};
-use crate::fmu::fmi2::{StepWarning, WORSENED};
+use crate::fmu::fmi2::{StepWarning, Warned};
 use crate::sim::{SideFrameSpec, Simulation, VehicleSpec};
 use crate::vehicle::{
     CONTACT_STIFFNESS, ExchangeLimits, HeldForce, PartnerFit, RollPlaneParams, SideFrameInertia,
@@ -69,8 +69,9 @@ pub(super) struct PartnerWatch {
     /// The largest jump of the primary forces when inputs came in, since the last
     /// warning's check (N), and where.
     jump: f64,
-    /// The conditions warned of and their severity then.
-    warned: Vec<(&'static str, f64)>,
+    /// The conditions warned of (each watched alike at every step, so that one that
+    /// holds hides none of the others behind the layer's own record).
+    warned: Warned,
     /// Communication steps taken.
     steps: u64,
     /// What it did of its own accord since last asked (the fitted side frames taken).
@@ -142,7 +143,7 @@ impl PartnerWatch {
         let wheelbase = s.trailing.first().map_or(0.0, |w| w.offset);
         let static_load = sim.static_load();
         let (inertia, _) = side_frames.inertia(s)?;
-        let limits = carried_limits(vehicle, inertia, shared, static_load, CONTACT_STIFFNESS)?;
+        let (omega, limits) = carried(vehicle, inertia, shared, static_load)?;
         let n = sim.wheelsets().len();
         let mut w = PartnerWatch {
             fit: PartnerFit::new(n, shared, wheelbase),
@@ -151,13 +152,13 @@ impl PartnerWatch {
             mass,
             pitch_inertia,
             wheelbase,
-            omega: (vehicle.primary_stiffness * (inertia.direct + inertia.cross)).sqrt(),
+            omega,
             auto,
             adopted: false,
             limits,
             point: Vec::new(),
             jump: 0.0,
-            warned: Vec::new(),
+            warned: Warned::default(),
             steps: 0,
             events: Vec::new(),
             last_frames: None,
@@ -233,12 +234,7 @@ impl PartnerWatch {
     /// `static_load.*`, so a partner whose own differ moves off at `(F - F_own) / m`, the
     /// carried side frames' mass `m`.
     fn first_step_load(&self, h: f64, v0: &[f64], v: &[f64]) -> [f64; 2] {
-        // The side frames' mass per axle box.
-        let m = if self.pitch_inertia.is_some() {
-            0.5 * self.mass
-        } else {
-            self.mass
-        };
+        let m = self.per_axle_box(self.mass);
         let mut off = [0.0; 2];
         let boxes = v.len().min(v0.len());
         for i in 0..boxes {
@@ -247,6 +243,16 @@ impl PartnerWatch {
         // The partner's static primary force is TrackContact's minus what moved it.
         let ours = self.static_load;
         [ours[0] - off[0], ours[1] - off[1]]
+    }
+
+    /// A side frame's mass `mass` (kg) as `vehicle.sideframe.mass` gives it, per axle
+    /// box: half of it where a side frame spans two wheelsets (pitching, shared).
+    fn per_axle_box(&self, mass: f64) -> f64 {
+        if self.pitch_inertia.is_some() {
+            0.5 * mass
+        } else {
+            mass
+        }
     }
 
     /// What it did of its own accord since last asked.
@@ -260,29 +266,13 @@ impl PartnerWatch {
         self.point.clear();
     }
 
-    /// Whether `kind` at `severity` is new or worse by [`WORSENED`] than last warned:
-    /// then it is the one warned of.
-    fn fresh(&mut self, kind: &'static str, severity: f64) -> bool {
-        match self.warned.iter_mut().find(|(k, _)| *k == kind) {
-            Some((_, s)) if severity < WORSENED * *s => false,
-            Some((_, s)) => {
-                *s = severity;
-                true
-            }
-            None => {
-                self.warned.push((kind, severity));
-                true
-            }
-        }
-    }
-
     /// The warning after a step of `h` (s) ending at `time` (s), if any: the output
     /// choice, the copy of the side frames (or, auto, the fitted ones taken), the step
     /// beyond the stable one, the exchange's jump.
     pub fn warning(&mut self, sim: &mut Simulation, time: f64, h: f64) -> Option<StepWarning> {
         self.steps += 1;
         if self.still_velocities >= STILL_VELOCITY_POINTS
-            && self.fresh("side-frame velocities", 1.0)
+            && self.warned.fresh("side-frame velocities", 1.0)
         {
             return Some(StepWarning::once(
                 "side-frame velocities",
@@ -302,7 +292,7 @@ impl PartnerWatch {
             let off = (0..2)
                 .map(|s| (own[s] - self.static_load[s]).abs() / load)
                 .fold(0.0, f64::max);
-            if off > STATIC_TOLERANCE && self.fresh("static load", 1.0) {
+            if off > STATIC_TOLERANCE && self.warned.fresh("static load", 1.0) {
                 return Some(StepWarning::once(
                     "static load",
                     format!(
@@ -326,7 +316,7 @@ impl PartnerWatch {
         let held = estimate.map(|e| e.held);
         if let Some(e) = estimate
             && e.held.output() != e.held.right_output()
-            && self.fresh("axle-box output", 1.0)
+            && self.warned.fresh("axle-box output", 1.0)
         {
             return Some(StepWarning::once(
                 "axle-box output",
@@ -335,17 +325,13 @@ impl PartnerWatch {
         }
         if let Some(e) = estimate.filter(|_| h * self.omega <= FIT_STEP_RADIANS) {
             // Side frames outside every physical range: not the partner's, the inputs.
-            let per_box = if self.pitch_inertia.is_some() {
-                0.5 * e.mass
-            } else {
-                e.mass
-            };
-            let physical = crate::limits::check("vehicle.sideframe.mass", per_box).is_ok()
-                && e.pitch_inertia.is_none_or(|j| {
-                    crate::limits::check("vehicle.sideframe.pitch_inertia", j).is_ok()
-                });
+            let physical =
+                crate::limits::check("vehicle.sideframe.mass", self.per_axle_box(e.mass)).is_ok()
+                    && e.pitch_inertia.is_none_or(|j| {
+                        crate::limits::check("vehicle.sideframe.pitch_inertia", j).is_ok()
+                    });
             if !physical {
-                return self.fresh("side-frame units", 1.0).then(|| {
+                return self.warned.fresh("side-frame units", 1.0).then(|| {
                     StepWarning::once(
                         "side-frame units",
                         format!(
@@ -382,7 +368,7 @@ impl PartnerWatch {
                     let late = severity > 1.0 && self.departure > IMPACT_DEPARTURE;
                     let before = self.copy_message(time, e.mass, e.pitch_inertia);
                     self.adopt(sim, mass, e.pitch_inertia);
-                    if late && self.fresh("side frames taken late", 1.0) {
+                    if late && self.warned.fresh("side frames taken late", 1.0) {
                         return Some(StepWarning::once(
                             "side frames taken late",
                             format!(
@@ -394,7 +380,7 @@ impl PartnerWatch {
                         ));
                     }
                 }
-            } else if severity > 1.0 && self.fresh("side-frame copy", severity) {
+            } else if severity > 1.0 && self.warned.fresh("side-frame copy", severity) {
                 return Some(StepWarning::worse(
                     "side-frame copy",
                     severity,
@@ -417,7 +403,7 @@ impl PartnerWatch {
                 limit
             };
             let known = held.is_some() || self.steps > KIND_WAIT_STEPS;
-            if known && h > most * (1.0 + 1e-9) && self.fresh("axle-box step", h / most) {
+            if known && h > most * (1.0 + 1e-9) && self.warned.fresh("axle-box step", h / most) {
                 return Some(StepWarning::worse(
                     "axle-box step",
                     h / most,
@@ -427,7 +413,10 @@ impl PartnerWatch {
         }
         let load = self.static_load[0].max(self.static_load[1]);
         let jump = std::mem::take(&mut self.jump);
-        if jump > JUMP_TOLERANCE * load && self.fresh("axle-box jump", jump / load / JUMP_TOLERANCE)
+        if jump > JUMP_TOLERANCE * load
+            && self
+                .warned
+                .fresh("axle-box jump", jump / load / JUMP_TOLERANCE)
         {
             return Some(StepWarning::worse(
                 "axle-box jump",
@@ -462,7 +451,7 @@ impl PartnerWatch {
         // Fitted values outside what the links take are not taken (the warning of the
         // copy stays as it was).
         if sim.set_side_frame_inertia(inertia).is_ok() {
-            let per_box = if j.is_some() { 0.5 * mass } else { mass };
+            let per_box = self.per_axle_box(mass);
             self.events.push(format!(
                 "vehicle.sideframe.source = auto: at t = {} s took the partner's side frames as \
                  fitted from the exchange: vehicle.sideframe.mass = {} kg per axle box{}",
@@ -476,17 +465,10 @@ impl PartnerWatch {
             self.mass = mass;
             self.pitch_inertia = j;
             self.adopted = true;
-            self.omega =
-                (self.wheelset.primary_stiffness * (inertia.direct + inertia.cross)).sqrt();
-            let shared = j.is_some();
-            if let Ok(l) = carried_limits(
-                &self.wheelset,
-                inertia,
-                shared,
-                self.static_load,
-                CONTACT_STIFFNESS,
-            ) {
-                self.limits = l;
+            if let Ok((omega, limits)) =
+                carried(&self.wheelset, inertia, j.is_some(), self.static_load)
+            {
+                (self.omega, self.limits) = (omega, limits);
             }
         }
     }
@@ -494,11 +476,7 @@ impl PartnerWatch {
     /// The copy of the side frames against the fitted `mass` (kg) and `pitch` (kg m^2):
     /// what is carried, how far off, and the values beyond their tolerances to set.
     fn copy_message(&self, time: f64, mass: f64, pitch: Option<f64>) -> String {
-        let (per_box, set_mass) = match self.pitch_inertia {
-            // Over two wheelsets vehicle.sideframe.mass is half a side frame.
-            Some(_) => (0.5 * self.mass, 0.5 * mass),
-            None => (self.mass, mass),
-        };
+        let (per_box, set_mass) = (self.per_axle_box(self.mass), self.per_axle_box(mass));
         // How far each carried value is from the partner's, as a share of the partner's.
         let off = |carried: f64, fitted: f64| format!("{:+.0} %", 100.0 * (carried / fitted - 1.0));
         let mut carried = format!(
@@ -592,6 +570,21 @@ impl PartnerWatch {
             sig(most)
         )
     }
+}
+
+/// What TrackContact's copy of the side frames `inertia` (over two wheelsets' boxes when
+/// `shared`) on the primary suspension of `wheelset`, under the static wheel loads
+/// `static_load` (N), sets: their bounce on the primary springs (rad/s) and the
+/// exchange's stable steps ([`carried_limits`]).
+fn carried(
+    wheelset: &RollPlaneParams,
+    inertia: SideFrameInertia,
+    shared: bool,
+    static_load: [f64; 2],
+) -> Result<(f64, Option<ExchangeLimits>)> {
+    let omega = (wheelset.primary_stiffness * (inertia.direct + inertia.cross)).sqrt();
+    let limits = carried_limits(wheelset, inertia, shared, static_load, CONTACT_STIFFNESS)?;
+    Ok((omega, limits))
 }
 
 fn output_message(time: f64, held: HeldForce, residual: f64) -> String {

@@ -47,7 +47,7 @@ pub struct Instance<M: Model> {
     /// The kinds of step warning ([`Model::step_warning`]) warned of in this run, with
     /// the severity last warned of, until `fmi2Reset` (FMU states leave them as they
     /// are).
-    pub(super) step_warned: Vec<(&'static str, f64)>,
+    pub(super) step_warned: super::model::Warned,
     logger: Logger,
     logging_on: bool,
     categories: [bool; 4],
@@ -92,7 +92,7 @@ impl<M: Model> Instance<M> {
             stop_time: None,
             ended: false,
             failed: None,
-            step_warned: Vec::new(),
+            step_warned: super::model::Warned::default(),
             logger,
             logging_on,
             categories: [true; 4],

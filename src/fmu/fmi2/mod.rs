@@ -16,7 +16,7 @@ mod values;
 pub(crate) use calls::ALL;
 pub use calls::{Allowed, CALLS, Call, Phase};
 pub use instance::Instance;
-pub use model::{Model, OutputFault, StepError, StepFault, StepWarning, WORSENED};
+pub use model::{Model, OutputFault, StepError, StepFault, StepWarning, WORSENED, Warned};
 #[cfg(test)]
 pub(crate) use states::MAGIC;
 pub use states::Snapshot;

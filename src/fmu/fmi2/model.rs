@@ -57,6 +57,35 @@ impl StepWarning {
     }
 }
 
+/// The conditions warned of in a run and the severity each was last warned of at: a
+/// condition is warned of when it starts and when it reaches [`WORSENED`] times that
+/// severity ([`Model::step_warning`]).
+#[derive(Debug, Clone, Default)]
+pub struct Warned(Vec<(&'static str, f64)>);
+
+impl Warned {
+    /// Whether the condition `kind` at `severity` is to be warned of (new, or worse by
+    /// [`WORSENED`] than last warned of); if so, it is recorded as warned of.
+    pub fn fresh(&mut self, kind: &'static str, severity: f64) -> bool {
+        match self.0.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, s)) if severity < WORSENED * *s => false,
+            Some((_, s)) => {
+                *s = severity;
+                true
+            }
+            None => {
+                self.0.push((kind, severity));
+                true
+            }
+        }
+    }
+
+    /// Forgets every condition (a new run).
+    pub fn clear(&mut self) {
+        self.0.clear();
+    }
+}
+
 /// Why `fmi2DoStep` did not complete.
 #[derive(Debug)]
 pub enum StepError {

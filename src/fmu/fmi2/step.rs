@@ -3,7 +3,7 @@
 
 use super::calls::{Call, Phase};
 use super::instance::Instance;
-use super::model::{Model, StepError, StepFault, WORSENED};
+use super::model::{Model, StepError, StepFault};
 use super::status::{FmiResult, Status};
 use crate::error::num;
 
@@ -122,11 +122,8 @@ impl<M: Model> Instance<M> {
             // worsens WORSENED times; a step that ends in it unchanged has nothing new to
             // report and returns fmi2OK, logging nothing (a warning at every step stopped
             // C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
-            let last = self.step_warned.iter_mut().find(|(k, _)| *k == w.kind);
-            match last {
-                Some((_, s)) if w.severity < WORSENED * *s => return Ok(()),
-                Some((_, s)) => *s = w.severity,
-                None => self.step_warned.push((w.kind, w.severity)),
+            if !self.step_warned.fresh(w.kind, w.severity) {
+                return Ok(());
             }
             let message = format!("fmi2DoStep: {}", w.message);
             self.warn(&message);
