@@ -50,7 +50,8 @@ impl Fnv {
     }
 }
 
-fn run(name: &str, s: &Scenario, duration: f64) {
+/// The hash of every sample of `s` over `duration` (s), and the steps taken.
+fn run(s: &Scenario, duration: f64) -> (u64, u64) {
     let mut sim = Simulation::new(s).unwrap();
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
     h.sample(&sim.sample());
@@ -58,20 +59,25 @@ fn run(name: &str, s: &Scenario, duration: f64) {
     for _ in 0..n {
         h.sample(&sim.step().unwrap());
     }
-    println!("{name}: {n} steps, sample hash {:016x}", h.0);
+    (h.0, n)
 }
 
-fn main() {
-    let only = std::env::args().nth(1);
-    let run = |key: &str, name: &str, s: &Scenario, duration: f64| {
-        if only.as_deref().is_none_or(|o| o == key) {
-            run(name, s, duration);
+/// The reference runs `only` names (all six with `None`), in order: their names, the
+/// sample hashes and the steps taken (`tests/reference_hashes.rs` holds them to the
+/// recorded bits).
+pub fn hashes(only: Option<&str>) -> Vec<(String, u64, u64)> {
+    let mut out = Vec::new();
+    let mut run = |key: &str, name: &str, s: &Scenario, duration: f64| {
+        if only.is_none_or(|o| o == key) {
+            let (h, n) = run(s, duration);
+            out.push((name.to_string(), h, n));
         }
         let key = format!("{key}-linear");
-        if only.as_deref().is_none_or(|o| o == key) {
+        if only.is_none_or(|o| o == key) {
             let mut linear = s.clone();
             linear.set_between_nodes(RailBetweenNodes::Linear);
-            run(&format!("{name}, linear (3.23)"), &linear, duration);
+            let (h, n) = run(&linear, duration);
+            out.push((format!("{name}, linear (3.23)"), h, n));
         }
     };
     let mut seed = Scenario::table_4_4_flat();
@@ -88,4 +94,13 @@ fn main() {
     flats.flats[0].push(FlatSpec::haversine(mm(60.0), mm(0.8), deg(250.0)));
     flats.flats[1].push(FlatSpec::chord(mm(80.0), deg(120.0)));
     run("flats", "three more flats, 0.3 s", &flats, 0.3);
+    out
+}
+
+#[allow(dead_code)]
+fn main() {
+    let only = std::env::args().nth(1);
+    for (name, h, n) in hashes(only.as_deref()) {
+        println!("{name}: {n} steps, sample hash {h:016x}");
+    }
 }

@@ -22,12 +22,23 @@ const WAGON: [f64; 3] = [1.8, 10.0, 11.8];
 fn main() {
     let arg = |k: usize| std::env::args().nth(k);
     let which = arg(1).unwrap_or_else(|| "both".into());
-    let wheelsets: usize = arg(2).and_then(|s| s.parse().ok()).unwrap_or(1);
+    // WHEELSETS "wagon" is the four-axle wagon (`Scenario::table_4_4_wagon`) on its own
+    // four wheelsets, a number that many roll-plane vehicles.
+    let wagon = arg(2).as_deref() == Some("wagon");
+    let wheelsets: usize = if wagon {
+        4
+    } else {
+        arg(2).and_then(|s| s.parse().ok()).unwrap_or(1)
+    };
     let n: u64 = arg(3).and_then(|s| s.parse().ok()).unwrap_or(20_000);
     let side: f64 = arg(4)
         .and_then(|s| s.parse().ok())
         .unwrap_or(TrackWindow::CONVERGED.ahead);
-    let mut s = Scenario::table_4_4_flat();
+    let mut s = if wagon {
+        Scenario::table_4_4_wagon()
+    } else {
+        Scenario::table_4_4_flat()
+    };
     s.window = (side > 0.0).then_some(TrackWindow {
         ahead: side,
         behind: side,
@@ -55,7 +66,13 @@ fn main() {
             reals.push((vr::TRACK_WINDOW_BEHIND, side));
         }
         reals.extend(OFFSET_VRS.iter().copied().zip(WAGON));
-        let integers = [(vr::WHEELSETS, wheelsets as i32)];
+        let mut integers = vec![(vr::WHEELSETS, wheelsets as i32)];
+        if wagon {
+            integers.push((
+                vr::VEHICLE_MODEL,
+                wheelflat::fmu::vars::enums::vehicle_model::WAGON as i32,
+            ));
+        }
         let per_call: u64 = arg(5).and_then(|s| s.parse().ok()).unwrap_or(1).max(1);
         let (c, dt) = ffi_instance::initialised(COUPLED_SYSTEM.guid, &reals, &integers);
         let (n, dt) = (n / per_call, dt * per_call as f64);

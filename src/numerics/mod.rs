@@ -15,7 +15,7 @@ mod small_angle;
 mod table;
 
 pub(crate) use banded::solve_banded_spd;
-pub(crate) use central_difference::{CentralDifference, check_critical_step};
+pub(crate) use central_difference::{CentralDifference, check_critical_step, mat_vec_dispatched};
 pub use harmonic::harmonic_amplitude;
 pub use modes::natural_frequencies;
 pub(crate) use quadrature::gauss_legendre;

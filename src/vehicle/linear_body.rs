@@ -90,7 +90,7 @@ pub trait LinearVehicle<const N: usize, const S: usize>:
         _constant: &SVector<f64, N>,
         p: &Axles,
     ) -> SVector<f64, N> {
-        p_force * (gravity + self.contact_force(p))
+        crate::numerics::mat_vec_dispatched(p_force, &(gravity + self.contact_force(p)))
     }
     /// The part of [`LinearVehicle::force_share`] that stays the same from step to step
     /// for the update's `p_force` and the gravity `gravity` (zero by default, unused).
