@@ -2,7 +2,8 @@
 //! sample hashes of `tools/sample_hash.rs` (`cargo run --release --example
 //! sample_hash`) against those recorded when the rail between nodes became a beam
 //! (issue 27) and, for the thesis' linear interpolation (3.23), against every run
-//! before it. The vector levels (AVX2, AVX-512, both with FMA) give these bits; the
+//! before it; and the wagon on the default window, as it was before issue 42's speed
+//! work on the wheelsets it shares. The vector levels (AVX2, AVX-512, both with FMA) give these bits; the
 //! baseline rounds every product of the track loops and agrees to rounding only, so
 //! the check needs FMA.
 

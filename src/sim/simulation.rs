@@ -291,13 +291,20 @@ impl Simulation {
     #[inline(always)]
     fn sample_trailing_body(&mut self) -> Result<()> {
         for k in 0..self.wheelsets.trailing().len() {
+            // Built in place in `latest`, as the leading wheelset's (see `step_body`).
             let w = &self.wheelsets.trailing()[k];
-            let s = match w.cached.take() {
-                Some(s) => s,
-                None => self.compute_sample(w),
-            };
-            self.wheelsets.trailing_mut()[k].latest = s;
-            if !displacements_within(&s) {
+            if let Some(s) = w.cached.take() {
+                self.wheelsets.trailing_mut()[k].latest = s;
+            } else {
+                let head = self.sample_head(w);
+                let compliance = self.compliance_under(head.1 - self.origin);
+                let shift = self.irregularity_of(w, head.1, head.2);
+                let (wheels, vehicle, s) = self.wheelsets.trailing_mut()[k].parts_mut();
+                (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
+                contact_states(vehicle, &self.law, wheels, compliance, shift, s);
+            }
+            let s = &self.wheelsets.trailing()[k].latest;
+            if !displacements_within(s) {
                 return Err(self.displacement_diverged(&self.wheelsets.trailing()[k]));
             }
         }
