@@ -41,6 +41,8 @@ fn every_reference_run_keeps_its_bits() {
             0xe173932efd4e3ca6,
             20814,
         ),
+        // Recorded at the start of issue 42's work (d6a1225).
+        ("the wagon, default window, 0.1 s", 0xb8e99d2f1ce049f4, 6938),
     ];
     let got = sample_hash::hashes(None);
     assert_eq!(got.len(), want.len());
