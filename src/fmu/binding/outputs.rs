@@ -84,15 +84,20 @@ impl FmuModel {
             View::Vehicle(_) => None,
             View::Sim(sim, _) => sim.vehicle_of(index),
         };
-        let w = index.min(crate::vehicle::MAX_AXLES - 1);
-        let (bodies, w) = match (&view, vehicle) {
-            (View::Vehicle(u), _) => (Some(u.bodies()), w),
-            (View::Sim(..), Some((v, a))) => (Some(v.bodies()), a),
-            (View::Sim(..), None) => (None, w),
+        let w = match vehicle {
+            Some((_, a)) if matches!(view, View::Sim(..)) => a,
+            _ => index.min(crate::vehicle::MAX_AXLES - 1),
+        };
+        // The bodies' displacements, formed only for a quantity that reads them (a
+        // copy of every body: the contact forces, read at every step, do without).
+        let bodies = || match (&view, vehicle) {
+            (View::Vehicle(u), _) => Some(u.bodies()),
+            (View::Sim(..), Some((v, _))) => Some(v.bodies()),
+            (View::Sim(..), None) => None,
         };
         // The bolster's (0, 1) and the wheelset's (4, 5) bounce and roll, as the
         // roll-plane vehicle's `{z_b, phi_b, z_sfl, z_sfr, z_w, phi_w}` number them.
-        let body = |k: usize| match &bodies {
+        let body = |k: usize| match bodies() {
             Some(b) => match k {
                 0 | 1 => b.bolster[w][k],
                 _ => b.wheelset[w][k - 4],
@@ -173,15 +178,15 @@ impl FmuModel {
                 View::Sim(_, s) => s.position,
                 View::Vehicle(_) => f64::NAN,
             },
-            Quantity::CarbodyZ => bodies.map_or(0.0, |b| b.carbody[0]),
-            Quantity::CarbodyPitch => bodies.map_or(0.0, |b| b.carbody[1]),
-            Quantity::CarbodyRoll => bodies.map_or(0.0, |b| b.carbody[2]),
+            Quantity::CarbodyZ => bodies().map_or(0.0, |b| b.carbody[0]),
+            Quantity::CarbodyPitch => bodies().map_or(0.0, |b| b.carbody[1]),
+            Quantity::CarbodyRoll => bodies().map_or(0.0, |b| b.carbody[2]),
             Quantity::BolsterZ => body(0),
             Quantity::BolsterRoll => body(1),
             // Above the axle boxes of wheelset `index` (the half-car's side frames pitch).
             Quantity::SideframeZ => frames().map_or(f64::NAN, |f| f.0[side]),
             Quantity::SideframeV => frames().map_or(f64::NAN, |f| f.1[side]),
-            Quantity::SideframePitch => bodies.map_or(0.0, |b| b.sideframe_pitch[w][side]),
+            Quantity::SideframePitch => bodies().map_or(0.0, |b| b.sideframe_pitch[w][side]),
             // `wheelset.z`, `.roll` of the leading wheelset, `wheelset[2].z`, `.roll`.
             Quantity::WheelsetZ | Quantity::Z => body(4),
             Quantity::WheelsetRoll | Quantity::Roll => body(5),
