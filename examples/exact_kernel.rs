@@ -3,7 +3,9 @@
 //!
 //! `cargo run --release --example exact_kernel dump M FILE` writes the kernel's M + 1
 //! lags of the table 4.4 track (n = 8, the converged default step) as little-endian
-//! f64, lag by lag, each a 4 x 4 matrix row by row.
+//! f64, lag by lag, each a 4 x 4 matrix row by row. `dump M FILE E` writes the kernel
+//! of the exterior's rail node E instead (0 the end node, untapered; n = 8 the node
+//! that becomes the end when the window moves a span; issue 42).
 //!
 //! `cargo run --release --example exact_kernel echo FILE [DURATION]` reads such a
 //! kernel (any approximation of the dumped one), makes it both ends' boundary on a
@@ -68,9 +70,13 @@ fn main() {
             let (p, dt) = params(13);
             let mut t = Track::new(p, dt).unwrap();
             t.set_exact_ends(m).unwrap();
-            let bytes: Vec<u8> = t
-                .exact_end_kernel()
-                .unwrap()
+            // With a node E, the exterior's node E (0 the end, untapered).
+            let kernel = match args.get(3) {
+                Some(e) => t.exact_exterior_kernel(e.parse().expect("E")),
+                None => t.exact_end_kernel(),
+            };
+            let bytes: Vec<u8> = kernel
+                .expect("a node of the exterior's first span, 0 to n")
                 .iter()
                 .flatten()
                 .flatten()

@@ -323,6 +323,16 @@ impl Track {
         self.exact.as_ref().map(|e| &e.g[0][..])
     }
 
+    /// The kernel of the exterior's rail node `e` beyond the right end (`e = 0` the end
+    /// node itself, untapered: [`Track::exact_end_kernel`] is its tapered form; `e = n`
+    /// the node above the exterior's first sleeper, the end after a shift by a span),
+    /// as [`Track::exact_end_kernel`] lays it out: for studies of a recursive form of
+    /// the exact ends and of the maps a shift needs (issue 42). `None` without exact
+    /// ends or for `e` beyond `n`.
+    pub fn exact_exterior_kernel(&self, e: usize) -> Option<&[[[f64; 4]; 4]]> {
+        self.exact.as_ref()?.g.get(e).map(|g| &g[..])
+    }
+
     /// Replaces the kernel of [`Track::exact_end_kernel`] by `h` (as many lags): for
     /// studies of approximations of it. The span entering ahead keeps the exact
     /// kernels.
