@@ -32,7 +32,7 @@ pub(crate) fn mat_vec<const N: usize>(m: &SMatrix<f64, N, N>, x: &SVector<f64, N
     for j in 1..N {
         let xj = x[j];
         for i in 0..N {
-            y[i] = a[j][i] * xj + y[i];
+            y[i] += a[j][i] * xj;
         }
     }
     y
