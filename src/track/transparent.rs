@@ -59,7 +59,10 @@
 //! `32 M` multiply-adds a step and about `48 M^2` a shift (about 35 s of wall a
 //! simulated second at `M` = 0.1 s, 70 km/h); a recursive (pole) or FFT evaluation of
 //! the same kernels is what would make the short exact window cheaper than a long plain
-//! one (docs/PERFORMANCE.md). Engine only; the state vector carries the histories.
+//! one (docs/PERFORMANCE.md; issue 42 measured the recursive form and the maps its shifts
+//! need, `python/recursive_ends_study.py`: about 200 states a mode, three times what the
+//! fixed track's cost leaves the ends). Engine only; the state vector carries the
+//! histories.
 
 use super::*;
 
