@@ -59,16 +59,20 @@ impl Accelerations {
         let [h1, h2] = self.h;
         let uneven = h1 != h2;
         let k = 1.0 / (h1 * h1);
-        std::array::from_fn(|i| {
-            if self.recorded == 1 && i >= 2 {
+        // A plain loop: `std::array::from_fn` was left out of line once the coupled
+        // step had two copies calling it (60 instructions a step, issue 42).
+        let mut d = [0.0; SIGNALS];
+        for (i, di) in d.iter_mut().enumerate() {
+            *di = if self.recorded == 1 && i >= 2 {
                 // The rail under a wheel before its second sample.
                 0.0
             } else if uneven {
                 2.0 * ((z[i] - a[i]) / h1 - (a[i] - b[i]) / h2) / (h1 + h2)
             } else {
                 (z[i] - 2.0 * a[i] + b[i]) * k
-            }
-        })
+            };
+        }
+        d
     }
 
     /// Takes the displacements `z` (m) of the sample that drives the step `dt` (s)
