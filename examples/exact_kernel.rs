@@ -69,14 +69,25 @@ fn main() {
             let m: usize = args[1].parse().expect("M");
             let (p, dt) = params(13);
             let mut t = Track::new(p, dt).unwrap();
-            t.set_exact_ends(m).unwrap();
+            if let Err(e) = t.set_exact_ends(m) {
+                eprintln!("M = {m}: {e}");
+                std::process::exit(2);
+            }
             // With a node E, the exterior's node E (0 the end, untapered).
-            let kernel = match args.get(3) {
-                Some(e) => t.exact_exterior_kernel(e.parse().expect("E")),
+            let n = p.nodes_per_span;
+            let kernel = match args.get(3).map(|e| e.parse::<usize>()) {
+                Some(Ok(e)) if e <= n => t.exact_exterior_kernel(e),
+                Some(_) => {
+                    eprintln!(
+                        "E = {}: a node of the exterior's first span, 0 to {n}",
+                        args[3]
+                    );
+                    std::process::exit(2);
+                }
                 None => t.exact_end_kernel(),
             };
             let bytes: Vec<u8> = kernel
-                .expect("a node of the exterior's first span, 0 to n")
+                .expect("exact ends were set")
                 .iter()
                 .flatten()
                 .flatten()
@@ -116,6 +127,6 @@ fn main() {
                 approx / fixed
             );
         }
-        _ => eprintln!("exact_kernel dump M FILE | echo FILE [DURATION]"),
+        _ => eprintln!("exact_kernel dump M FILE [E] | echo FILE [DURATION]"),
     }
 }

@@ -36,15 +36,23 @@ def load(path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("end", help="kernel of the end node (exact_kernel dump M FILE 0)")
-    ap.add_argument("drive", help="kernel of node n - 1 (exact_kernel dump M FILE 7)")
+    ap.add_argument(
+        "next_inner",
+        help="kernel of the exterior's node n - 1, the last inner node after a shift "
+        "(exact_kernel dump M FILE 7 at the default n = 8)",
+    )
     ap.add_argument("--hankel", type=int, default=1500, help="block rows and columns P")
     ap.add_argument("--orders", default="40,80,120,200")
     a = ap.parse_args()
-    h, gv = load(a.end), load(a.drive)
+    h, gv = load(a.end), load(a.next_inner)
+    p = a.hankel
+    need = max(3001, 2 * p + 2)
+    if min(len(h), len(gv)) < need:
+        ap.error(f"the kernels have {min(len(h), len(gv))} lags; --hankel {p} needs {need} "
+                 f"(exact_kernel dump {need - 1} ...)")
     # The rails' symmetry: the right rail answers as the left.
     assert np.allclose(h[:, 2:4, 2:4], h[:, 0:2, 0:2])
     orders = [int(x) for x in a.orders.split(",")]
-    p = a.hankel
     for name, sign in [("symmetric", 1.0), ("antisymmetric", -1.0)]:
         hm = h[:, 0:2, 0:2] + sign * h[:, 0:2, 2:4]
         gm = gv[:, 0:2, 0:2] + sign * gv[:, 0:2, 2:4]

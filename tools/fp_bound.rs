@@ -1,8 +1,11 @@
 //! The track step against the machine it runs on (issue 42): the fraction of the
-//! floating-point ports' bound that the track's loops reach, at every SIMD level this
-//! CPU has, for the thesis' fixed 30-span track, the FMUs' default window (10 m a
-//! side) and the converged window (20 m a side), all at the converged default grid
-//! (n = 8, its default step).
+//! floating-point ports' bound that the track's loops reach, at each vector level this
+//! CPU has (AVX2, AVX-512; the baseline has no bound to speak of), for tracks of the
+//! thesis' fixed 30 spans, of the FMUs' default window (10 m a side, 31 spans) and of
+//! the converged window (20 m a side, 60 spans), all at the converged default grid
+//! (n = 8, its default step). Each is stepped as a fixed track of that many spans: a
+//! window's shift (a copy of the state, about a step's cost each sleeper span the wheel
+//! travels) is not in it.
 //!
 //! The bound counts the vector floating-point instructions of the loops of
 //! `src/track/kernels.rs` over the padded, phase-blocked slots (`n x 2 x S` rail
@@ -13,10 +16,11 @@
 //! ports are those of Intel's Golden Cove cores (Sapphire Rapids, the machines this
 //! project has run on): 512-bit vectors on two ports (0 and 5), each taking any of
 //! them; 256-bit ones on three (0, 1, 5), products and multiply-adds on two of them
-//! (0, 1). Cycles are wall time at the clock `/proc/cpuinfo` names, a virtual
-//! machine's nominal clock: turbo makes the fraction look better than it is. Each
-//! track is timed over `STEPS` steps (default 20,000) under two moving wheel loads,
-//! the levels interleaved, best of five rounds.
+//! (0, 1). On other cores the bound is that model's, not theirs (the output says so).
+//! Cycles are wall time at the clock `/proc/cpuinfo` names: on a virtual machine its
+//! nominal clock (turbo makes the fraction look better than it is), on bare metal the
+//! clock of the moment. Each track is timed over `STEPS` steps (default 20,000) under
+//! two moving wheel loads, the levels interleaved, best of five rounds.
 //!
 //! `cargo run --release --example fp_bound`
 
@@ -78,7 +82,10 @@ fn main() {
             Some(TrackWindow::CONVERGED),
         ),
     ];
-    println!("CPU: {}", model());
+    println!(
+        "CPU: {} (the bound is Golden Cove's port model: tools/fp_bound.rs)",
+        model()
+    );
     match hz {
         Some(hz) => println!("clock (/proc/cpuinfo): {:.0} MHz", hz / 1e6),
         None => println!("no clock in /proc/cpuinfo: cycles not shown"),

@@ -60,9 +60,9 @@
 //! simulated second at `M` = 0.1 s, 70 km/h); a recursive (pole) or FFT evaluation of
 //! the same kernels is what would make the short exact window cheaper than a long plain
 //! one (docs/PERFORMANCE.md; issue 42 measured the recursive form and the maps its shifts
-//! need, `python/recursive_ends_study.py`: about 200 states a mode, three times what the
-//! fixed track's cost leaves the ends). Engine only; the state vector carries the
-//! histories.
+//! need, `python/recursive_ends_study.py`: about 200 states a mode, 1.6 times what the
+//! fixed track's cost leaves the ends of a 4 m window). Engine only; the state vector
+//! carries the histories.
 
 use super::*;
 
