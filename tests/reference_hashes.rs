@@ -3,9 +3,9 @@
 //! sample_hash`) against those recorded when the rail between nodes became a beam
 //! (issue 27) and, for the thesis' linear interpolation (3.23), against every run
 //! before it; and the wagon on the default window, as it was before issue 42's speed
-//! work on the wheelsets it shares. The vector levels (AVX2, AVX-512, both with FMA) give these bits; the
-//! baseline rounds every product of the track loops and agrees to rounding only, so
-//! the check needs FMA.
+//! work on the wheelsets it shares. The vector levels (AVX2, AVX-512, both with FMA)
+//! give these bits; the baseline rounds every product of the track loops and agrees to
+//! rounding only, so the check needs FMA.
 
 #[path = "../tools/sample_hash.rs"]
 mod sample_hash;

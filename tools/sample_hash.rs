@@ -65,7 +65,7 @@ fn hash_run(s: &Scenario, duration: f64) -> (u64, u64) {
     (h.0, n)
 }
 
-/// The reference runs `only` names (all six with `None`), in order: their names, the
+/// The reference runs `only` names (all seven with `None`), in order: their names, the
 /// sample hashes and the steps taken (`tests/reference_hashes.rs` holds them to the
 /// recorded bits).
 pub fn hashes(only: Option<&str>) -> Vec<(String, u64, u64)> {

@@ -16,7 +16,7 @@ const SMALL_BODY: usize = 8;
 /// over the columns in order, each product rounded (`y = m_0 x_0`, then
 /// `y = m_j x_j + y`), so that the result has the same bits as `m * x`, while the rows
 /// are left to the vector units of the caller's [`SimdLevel`] (the wagon's 19 degrees
-/// of freedom: 1,890 instructions a step through nalgebra's generic product, issue 42).
+/// of freedom: 1,865 instructions a step through nalgebra's generic product, issue 42).
 #[inline(always)]
 pub(crate) fn mat_vec<const N: usize>(m: &SMatrix<f64, N, N>, x: &SVector<f64, N>) -> [f64; N] {
     // The columns as arrays (nalgebra stores a matrix column by column), so that the
@@ -157,20 +157,9 @@ impl<const N: usize> CentralDifference<N> {
     /// caller).
     #[inline(always)]
     pub(crate) fn advance_premultiplied(&mut self, pf: SVector<f64, N>) {
-        let (p_cur, p_prev, d, d_prev) = (&self.p_cur, &self.p_prev, &self.d, &self.d_prev);
-        if N <= SMALL_BODY {
-            let next = p_cur * d + p_prev * d_prev + pf;
-            self.d_prev = self.d;
-            self.d = next;
-            return;
-        }
-        let next = SimdLevel::detect().min(SimdLevel::Avx2).run(
-            #[inline(always)]
-            || {
-                let (a, b) = (mat_vec(p_cur, d), mat_vec(p_prev, d_prev));
-                SVector::from_fn(|i, _| (a[i] + b[i]) + pf[i])
-            },
-        );
+        let next = mat_vec_dispatched(&self.p_cur, &self.d)
+            + mat_vec_dispatched(&self.p_prev, &self.d_prev)
+            + pf;
         self.d_prev = self.d;
         self.d = next;
     }

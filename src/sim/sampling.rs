@@ -98,6 +98,26 @@ impl Simulation {
         s
     }
 
+    /// Builds wheelset `k`'s (0 the leading one) sample at the current time in place in
+    /// its `latest`, whose contact states (the step before's) start the contact's
+    /// solve: the same bits as [`Simulation::compute_sample`], without a sample built in
+    /// a temporary and copied at once (the copy's wide loads waited on the narrow stores
+    /// that had just built it). `k` is one the simulation has.
+    #[inline(always)]
+    pub(super) fn sample_in_place(&mut self, k: usize) {
+        let w = &self.wheelsets.get(k).expect("a wheelset of the simulation");
+        let head = self.sample_head(w);
+        let compliance = self.compliance_under(head.1 - self.origin);
+        let shift = self.irregularity_of(w, head.1, head.2);
+        let w = self
+            .wheelsets
+            .get_mut(k)
+            .expect("a wheelset of the simulation");
+        let (wheels, vehicle, s) = w.parts_mut();
+        (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
+        contact_states(vehicle, &self.law, wheels, compliance, shift, s);
+    }
+
     #[inline(always)]
     pub(super) fn compute_sample(&self, w: &Wheelset) -> Sample {
         // The step before's contact forces start the contact's solve, as in `step`

@@ -10,7 +10,7 @@ use super::clock::{Clock, StepPlan};
 use super::motion::{Motion, Window};
 use super::sites::Site;
 use super::vehicle_state::VehicleState;
-use super::wheelset::{Sample, Wheelset, Wheelsets, contact_states, wheel_loads};
+use super::wheelset::{Sample, Wheelset, Wheelsets, wheel_loads};
 use crate::contact::ContactLaw;
 use crate::error::{Error, Result, non_negative, num};
 use crate::limits::{DISPLACEMENT_LIMIT, HEALTH_CHECK_INTERVAL, MAX_NODE_STEPS_PER_CALL, within};
@@ -247,17 +247,11 @@ impl Simulation {
         }
         // The cached sample, if the outputs were read at this instant, is used up here;
         // otherwise the sample is built in place in `latest` and copied out once the
-        // step is done (a sample built in a temporary was copied at once, and the
-        // copy's wide loads waited on the narrow stores that had just built it).
+        // step is done.
         if let Some(s) = self.wheelsets.lead().cached.take() {
             self.wheelsets.lead_mut().latest = s;
         } else {
-            let head = self.sample_head(self.lead());
-            let compliance = self.compliance_under(head.1 - self.origin);
-            let shift = self.irregularity_of(self.lead(), head.1, head.2);
-            let (wheels, vehicle, s) = self.wheelsets.lead_mut().parts_mut();
-            (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
-            contact_states(vehicle, &self.law, wheels, compliance, shift, s);
+            self.sample_in_place(0);
         }
         if !displacements_within(&self.lead().latest) {
             return Err(self.displacement_diverged(self.lead()));
@@ -291,17 +285,10 @@ impl Simulation {
     #[inline(always)]
     fn sample_trailing_body(&mut self) -> Result<()> {
         for k in 0..self.wheelsets.trailing().len() {
-            // Built in place in `latest`, as the leading wheelset's (see `step_body`).
-            let w = &self.wheelsets.trailing()[k];
-            if let Some(s) = w.cached.take() {
+            if let Some(s) = self.wheelsets.trailing()[k].cached.take() {
                 self.wheelsets.trailing_mut()[k].latest = s;
             } else {
-                let head = self.sample_head(w);
-                let compliance = self.compliance_under(head.1 - self.origin);
-                let shift = self.irregularity_of(w, head.1, head.2);
-                let (wheels, vehicle, s) = self.wheelsets.trailing_mut()[k].parts_mut();
-                (s.time, s.position, s.rotation, s.wheel_z, s.rail_z) = head;
-                contact_states(vehicle, &self.law, wheels, compliance, shift, s);
+                self.sample_in_place(k + 1);
             }
             let s = &self.wheelsets.trailing()[k].latest;
             if !displacements_within(s) {

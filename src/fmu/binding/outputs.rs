@@ -84,10 +84,8 @@ impl FmuModel {
             View::Vehicle(_) => None,
             View::Sim(sim, _) => sim.vehicle_of(index),
         };
-        let w = match vehicle {
-            Some((_, a)) if matches!(view, View::Sim(..)) => a,
-            _ => index.min(crate::vehicle::MAX_AXLES - 1),
-        };
+        // (A vehicle unit's view has no `vehicle`: it is its own.)
+        let w = vehicle.map_or(index.min(crate::vehicle::MAX_AXLES - 1), |(_, a)| a);
         // The bodies' displacements, formed only for a quantity that reads them (a
         // copy of every body: the contact forces, read at every step, do without).
         let bodies = || match (&view, vehicle) {
