@@ -1,6 +1,7 @@
 //! Build script: turns the one variable table `modelDescription/variables.xml` into
 //! - `$OUT_DIR/<modelIdentifier>.xml`, the modelDescription.xml of each FMU, with a
-//!   GUID derived from its content ([`model_description`]);
+//!   GUID derived from its content ([`model_description`]), and
+//!   `$OUT_DIR/fmi3/<modelIdentifier>.xml`, its FMI 3.0 model description ([`fmi3`]);
 //! - `$OUT_DIR/variables.rs`, the Rust table of the same variables (value references,
 //!   types, causalities, ranges, start values) that the FMI layer reads and writes
 //!   ([`rust_binding`]);
@@ -18,6 +19,7 @@
 
 mod c_header;
 mod documentation;
+mod fmi3;
 mod model_description;
 mod rust_binding;
 mod table;
@@ -45,9 +47,16 @@ fn main() {
         fs::write(out.join(format!("{}.xml", fmu.id())), md).unwrap();
         guids.push(guid);
     }
+    fs::create_dir_all(out.join("fmi3")).unwrap();
+    let mut tokens = Vec::new();
+    for fmu in &table.fmus {
+        let (md, token) = fmi3::write(&table, fmu, &version);
+        fs::write(out.join(format!("fmi3/{}.xml", fmu.id())), md).unwrap();
+        tokens.push(token);
+    }
     fs::write(
         out.join("variables.rs"),
-        rust_binding::write(&table, &guids),
+        rust_binding::write(&table, &guids) + &fmi3::rust(&table, &tokens),
     )
     .unwrap();
     fs::write(out.join("VARIABLES.md"), variables_md::write(&table)).unwrap();

@@ -24,7 +24,7 @@ pub fn xml_escape(s: &str) -> String {
 }
 
 /// 128-bit FNV-1a of the content, formatted as a GUID.
-fn guid(content: &str) -> String {
+pub fn guid(content: &str) -> String {
     let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
     for b in content.bytes() {
         h ^= b as u128;
@@ -43,7 +43,7 @@ fn guid(content: &str) -> String {
 
 /// The unit definitions `section` less the units none of the variables `fv` uses (one
 /// `<Unit>` per line in the table); `None` when none is used.
-fn used_units(section: &str, fv: &[crate::table::FmuVar]) -> Option<String> {
+pub fn used_units(section: &str, fv: &[crate::table::FmuVar]) -> Option<String> {
     let used: std::collections::BTreeSet<&str> = fv.iter().filter_map(|v| v.get("unit")).collect();
     let mut kept = 0;
     let lines: Vec<&str> = section
@@ -221,7 +221,7 @@ fn scalar_variable(table: &Table, k: usize, v: &FmuVar) -> String {
 /// trailing `*`, kept when they are inputs (`inputs_only`) or knowns of initialization
 /// mode. A plain name must exist in the table (catches typos); it may belong to
 /// another FMU.
-fn expand(
+pub fn expand(
     table: &Table,
     fmu: &Fmu,
     index: &BTreeMap<&str, usize>,

@@ -27,7 +27,7 @@ fn camel(name: &str) -> String {
 }
 
 /// `ContactModel` -> `contact_model` (`upper`: `CONTACT_MODEL`).
-fn split_camel(name: &str, upper: bool) -> String {
+pub fn split_camel(name: &str, upper: bool) -> String {
     let mut s = String::new();
     for (k, ch) in name.chars().enumerate() {
         if ch.is_uppercase() && k > 0 {

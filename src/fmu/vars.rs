@@ -85,10 +85,70 @@ pub struct FmuTable {
     pub vars: &'static [VarSpec],
 }
 
+/// The FMI 3.0 type of a variable ([`Var3Spec`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Type3 {
+    /// `fmi3Float64` (the table's Real).
+    Float64,
+    /// `fmi3Int32` (the table's Integer).
+    Int32,
+    /// An Enumeration, read and written as `fmi3Int64`.
+    Enumeration,
+    /// `fmi3String`.
+    String,
+    /// `wheelsets` where it is a parameter: a UInt64 structural parameter, set in
+    /// Configuration Mode, the size of every per-wheelset array.
+    Wheelsets,
+    /// A vehicle's `wheelsets`: a UInt64 constant.
+    Constant,
+}
+
+/// One variable of an FMU as an FMI 3.0 unit declares it: a scalar, or an array of one
+/// element per wheelset (the leading one first) whose elements are FMI 2.0 variables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Var3Spec {
+    /// Value reference: its leading element's FMI 2.0 one.
+    pub vr: u32,
+    /// Name.
+    pub name: &'static str,
+    /// Type.
+    pub ty: Type3,
+    /// FMI 3.0 causality.
+    pub causality: &'static str,
+    /// An array sized by `wheelsets`.
+    pub array: bool,
+    /// The FMI 2.0 value references of its elements, the leading wheelset's first (as
+    /// many as the FMU can have; the first `wheelsets` are in use).
+    pub elements: &'static [u32],
+    /// The value of a constant ([`Type3::Constant`]); NaN for the others.
+    pub constant: f64,
+}
+
+/// One FMU as an FMI 3.0 co-simulation unit: its FMI 2.0 table (the values, ranges and
+/// model), its instantiation token and model description, its FMI 3.0 variables.
+#[derive(Debug)]
+pub struct Fmu3Table {
+    /// The FMU's FMI 2.0 table, whose variables the FMI 3.0 ones are made of.
+    pub fmi2: &'static FmuTable,
+    /// `instantiationToken`, derived from the content of the model description.
+    pub token: &'static str,
+    /// The FMI 3.0 modelDescription.xml.
+    pub model_description: &'static str,
+    /// Variables in ModelVariables order.
+    pub vars: &'static [Var3Spec],
+}
+
+impl Fmu3Table {
+    /// The variable of value reference `vr`; `None` when the FMU has none.
+    pub fn var(&self, vr: u32) -> Option<&Var3Spec> {
+        self.vars.iter().find(|v| v.vr == vr)
+    }
+}
+
 // Start values are the table's literal numbers (pi/2 among them).
 #[allow(clippy::approx_constant)]
 mod generated {
-    use super::{Causality, FmuTable, UsedWhen, VarSpec, VarType};
+    use super::{Causality, Fmu3Table, FmuTable, Type3, UsedWhen, Var3Spec, VarSpec, VarType};
     include!(concat!(env!("OUT_DIR"), "/variables.rs"));
 }
 pub use generated::*;
