@@ -10,7 +10,9 @@
 
 pub mod binding;
 pub mod ffi;
+pub mod ffi3;
 pub mod fmi2;
+pub mod fmi3;
 #[cfg(test)]
 mod tests;
 pub mod vars;
@@ -22,5 +24,7 @@ pub use fmi2::{
 
 /// An instance of one of this project's FMUs.
 pub type Instance = fmi2::Instance<FmuModel>;
+/// An FMI 3.0 instance of one of this project's FMUs.
+pub type Instance3 = fmi3::Instance3<FmuModel>;
 /// An FMU state of one of this project's FMUs.
 pub type Snapshot = fmi2::Snapshot<FmuModel>;

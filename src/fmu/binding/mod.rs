@@ -84,6 +84,17 @@ impl Kind {
     }
 }
 
+impl Kind {
+    /// The FMI 3.0 table of this FMU.
+    pub fn table3(self) -> &'static vars::Fmu3Table {
+        let t = self.table();
+        vars::FMI3_FMUS
+            .into_iter()
+            .find(|x| std::ptr::eq(x.fmi2, t))
+            .expect("every FMU has its FMI 3.0 table")
+    }
+}
+
 impl crate::fmu::Instance {
     /// Which FMU this instance is.
     pub fn kind(&self) -> Kind {
