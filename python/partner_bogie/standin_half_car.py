@@ -34,95 +34,23 @@ stage evaluations, a fraction of the cost.
 Start: at static equilibrium under the primary forces that hold it, computed from the
 parameters (the inputs' start values are those forces, a quarter of the weight above
 the primary suspension each; inputs a master does not set keep them).
+
+The model itself (matrices, statics, RK4) is standin_bogie.py's ``StandinBogie``,
+numpy only, which this FMU carries beside this file; the FMI 3.0 export of the same
+bogie (standin_half_car3.py, pythonfmu3) steps the same class, so the two cannot drift.
+This file is its FMI 2.0 face: the scalar names below and pythonfmu's slave.
 """
 
-import math
-
-import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Status
 
-# The four axle boxes, in the order of the inputs and outputs: wheelset 1 left, right,
-# wheelset 2 left, right.
-BOXES = ("1L", "1R", "2L", "2R")
+try:  # imported as partner_bogie.standin_half_car (matrix.py, the tests)
+    from .standin_bogie import BOXES, N_DOF, PARAMETERS, StandinBogie, bogie_matrices, rk4_matrices, statics
+except ImportError:  # in the FMU: resources/ holds standin_bogie.py beside this file
+    from standin_bogie import BOXES, N_DOF, PARAMETERS, StandinBogie, bogie_matrices, rk4_matrices, statics
 
-# Parameters: name, default, unit, description.
-PARAMETERS = (
-    ("m_body", 40300.0, "kg", "Car-body mass carried by the bolster (the bogie's share: half the car body)"),
-    ("m_bolster", 465.0, "kg", "Bolster mass"),
-    ("J_bolster", 175.0, "kg.m2", "Roll inertia of the bolster with its car-body share"),
-    ("m_sideframe", 447.5, "kg", "Mass of ONE WHOLE side frame (it spans both wheelsets)"),
-    ("J_sideframe", 180.0, "kg.m2", "Pitch inertia of one side frame about its centre"),
-    ("sideframe_scale", 1.0, "1", "Factor on both m_sideframe and J_sideframe"),
-    ("k_sec", 5.1e6, "N/m", "Secondary stiffness per side"),
-    ("c_sec", 88480.0, "N.s/m", "Secondary damping per side"),
-    ("b_sec", 1.6002, "m", "Lateral distance between the two secondary suspensions"),
-    ("wheelbase", 1.8, "m", "Distance between the two wheelsets (axle boxes at +- wheelbase / 2)"),
-    ("g", 9.81, "m/s2", "Gravitational acceleration"),
-    ("z_frame_rest", -0.01725226666550715, "m",
-     "Side-frame height above each axle box at rest (the outputs' value at the start)"),
-    ("h_max", 1e-4, "s", "Largest integrator substep"),
-)
-
-# Degrees of freedom: bolster bounce, roll; left side frame bounce, pitch; right side
-# frame bounce, pitch.
-N_DOF = 6
-
-
-def bogie_matrices(p):
-    """M (diagonal, as a vector), K, C, the gravity load f_g and the map G of the four
-    box forces onto the degrees of freedom, for the parameters `p` (a dict)."""
-    s = p["sideframe_scale"]
-    msf, jsf = s * p["m_sideframe"], s * p["J_sideframe"]
-    mass = np.array([p["m_body"] + p["m_bolster"], p["J_bolster"], msf, jsf, msf, jsf])
-    k = np.zeros((N_DOF, N_DOF))
-    c = np.zeros((N_DOF, N_DOF))
-    for side, y in ((0, -0.5 * p["b_sec"]), (1, 0.5 * p["b_sec"])):
-        # Compression of the secondary suspension: bolster at y above the side frame.
-        a = np.zeros(N_DOF)
-        a[0], a[1], a[2 + 2 * side] = 1.0, y, -1.0
-        k += p["k_sec"] * np.outer(a, a)
-        c += p["c_sec"] * np.outer(a, a)
-    f_g = -p["g"] * np.array([mass[0], 0.0, msf, 0.0, msf, 0.0])
-    g_map = np.zeros((N_DOF, 4))
-    for col, box in enumerate(BOXES):
-        x = 0.5 * p["wheelbase"] * (1.0 if box[0] == "1" else -1.0)
-        side = 0 if box[1] == "L" else 1
-        g_map[2 + 2 * side, col] = 1.0
-        g_map[3 + 2 * side, col] = x
-    return mass, k, c, f_g, g_map
-
-
-def statics(p):
-    """The primary forces (N, the four boxes) that hold the bogie at rest and its
-    displacements there, with the side frames at 0 above every axle box.
-
-    The bogie above its primary suspension has four rigid modes (bounce, roll and each
-    side frame's pitch), which the secondary suspension does not hold: the forces are
-    those whose load is orthogonal to them (the weight shared equally), the state the
-    one that springs carry that load with the side frames level at 0 at the boxes."""
-    mass, k, c, f_g, g_map = bogie_matrices(p)
-    _, sv, vt = np.linalg.svd(k)
-    rank = int(np.sum(sv > sv[0] * 1e-12))
-    null = vt[rank:].T                        # the rigid modes, 6 x 4
-    # N^T (f_g + G F) = 0: four conditions on the four forces.
-    forces = np.linalg.solve(null.T @ g_map, -null.T @ f_g)
-    load = f_g + g_map @ forces
-    # K q = load with G^T q = 0 (the rigid modes fixed by the boxes' heights).
-    q, *_ = np.linalg.lstsq(np.vstack([k, g_map.T]), np.concatenate([load, np.zeros(4)]), rcond=None)
-    return forces, q
-
-
-def rk4_matrices(a, b, h):
-    """One classical RK4 step of ``x' = A x + B f`` with f held: ``x <- P x + R f``."""
-    n = a.shape[0]
-    ha = h * a
-    eye = np.eye(n)
-    ha2 = ha @ ha
-    ha3 = ha2 @ ha
-    p = eye + ha + ha2 / 2.0 + ha3 / 6.0 + ha3 @ ha / 24.0
-    r = h * (eye + ha / 2.0 + ha2 / 6.0 + ha3 / 24.0) @ b
-    return p, r
+__all__ = ["BOXES", "N_DOF", "PARAMETERS", "StandinBogie", "StandinHalfCar", "bogie_matrices", "rk4_matrices",
+           "statics"]
 
 
 class StandinHalfCar(Fmi2Slave):
@@ -155,7 +83,7 @@ class StandinHalfCar(Fmi2Slave):
                     f"{what}_frame_{box}", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                     description=f"Side frame {'displacement' if what == 'z' else 'velocity'} above axle box {box}, "
                                 f"up ({unit})"))
-        self._x = None
+        self._bogie = None
 
     def _parameters(self):
         return {name: float(getattr(self, name)) for name, *_ in PARAMETERS}
@@ -165,27 +93,15 @@ class StandinHalfCar(Fmi2Slave):
         self._set_by_master.add(box)
 
     def _prepare(self):
-        p = self._parameters()
-        mass, k, c, f_g, g_map = bogie_matrices(p)
-        forces, q = statics(p)
+        self._bogie = StandinBogie(self._parameters())
         # Inputs the master has not set hold the static forces of these parameters.
         for i, box in enumerate(BOXES):
             if box not in self._set_by_master:
-                setattr(self, f"F_box_{box}", float(forces[i]))
-        inv_m = 1.0 / mass
-        self._a = np.block([[np.zeros((N_DOF, N_DOF)), np.eye(N_DOF)],
-                            [-inv_m[:, None] * k, -inv_m[:, None] * c]])
-        self._b = np.vstack([np.zeros((N_DOF, N_DOF)), np.diag(inv_m)])
-        self._f_g, self._g = f_g, g_map
-        self._x = np.concatenate([q, np.zeros(N_DOF)])
-        self._steps = {}
-        self._h_max = p["h_max"]
-        self._rest = p["z_frame_rest"]
+                setattr(self, f"F_box_{box}", float(self._bogie.static_forces[i]))
         self._publish()
 
     def _publish(self):
-        z = self._rest + self._g.T @ self._x[:N_DOF]
-        v = self._g.T @ self._x[N_DOF:]
+        z, v = self._bogie.side_frames()
         for i, box in enumerate(BOXES):
             setattr(self, f"z_frame_{box}", float(z[i]))
             setattr(self, f"v_frame_{box}", float(v[i]))
@@ -194,23 +110,13 @@ class StandinHalfCar(Fmi2Slave):
         self._prepare()
 
     def do_step(self, current_time, step_size):
-        if self._x is None:
+        if self._bogie is None:
             self._prepare()
         if not step_size > 0.0:
             return True
-        n = max(1, math.ceil(step_size / self._h_max - 1e-9))
-        h = step_size / n
-        if h not in self._steps:
-            self._steps[h] = rk4_matrices(self._a, self._b, h)
-        p, r = self._steps[h]
-        u = np.array([getattr(self, f"F_box_{box}") for box in BOXES])
-        drive = r @ (self._f_g + self._g @ u)
-        x = self._x
-        for _ in range(n):
-            x = p @ x + drive
-        self._x = x
+        ok = self._bogie.step([getattr(self, f"F_box_{box}") for box in BOXES], step_size)
         self._publish()
-        if not (np.all(np.isfinite(x)) and np.max(np.abs(x[:N_DOF])) < 1.0):
+        if not ok:
             self.log(f"at t = {current_time + step_size} s the bogie's displacements left 1 m "
                      f"(the exchange diverged)", Fmi2Status.error)
             return False

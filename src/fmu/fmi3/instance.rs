@@ -5,10 +5,25 @@
 
 use super::calls::{Allowed3, CALLS3, Call3, Phase3};
 use super::messages::translate;
-use crate::fmu::fmi2::{FmiResult, Instance, Logger, Model, Snapshot, Status};
+use crate::fmu::fmi2::{FmiResult, Instance, Logger, Model, Refusal, Snapshot, Status};
 use crate::fmu::vars::{Fmu3Table, N_VR, Type3, Var3Spec};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// `r` of the FMI 2.0 layer with its refusal's message in FMI 3.0 terms (the logger's
+/// copy is translated on its way).
+fn fmi3<T>(table: &'static Fmu3Table, running: &AtomicUsize, r: FmiResult<T>) -> FmiResult<T> {
+    r.map_err(|e| Refusal {
+        status: e.status,
+        message: translate(
+            &e.message,
+            CALLS3
+                .get(running.load(Ordering::Relaxed).wrapping_sub(1))
+                .map(|c| c.0),
+            table,
+        ),
+    })
+}
 
 /// What `fmi3DoStep` reports besides its status.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +122,12 @@ impl<M: Model> Instance3<M> {
     /// Records `call` as running and refuses it unless [`CALLS3`] allows it in the
     /// current phase; the message names the function, the phase and where it is allowed.
     pub fn check(&mut self, call: Call3) -> FmiResult {
+        self.check_as(call, call.name())
+    }
+
+    /// [`Instance3::check`] of `call` for the function `name` of its family (the gets
+    /// and sets of the types no variable has).
+    pub fn check_as(&mut self, call: Call3, name: &str) -> FmiResult {
         self.running.store(call as usize + 1, Ordering::Relaxed);
         let phase = self.phase();
         match call.allowed() {
@@ -127,16 +148,14 @@ impl<M: Model> Instance3<M> {
                 self.refuse(
                     Status::Error,
                     format!(
-                        "{} is not allowed in state {phase:?}; allowed in: {}{why}",
-                        call.name(),
+                        "{name} is not allowed in state {phase:?}; allowed in: {}{why}",
                         names.join(", ")
                     ),
                 )
             }
-            Allowed3::Unsupported(why) => self.refuse(
-                Status::Error,
-                format!("{} is not supported: {why}", call.name()),
-            ),
+            Allowed3::Unsupported(why) => {
+                self.refuse(Status::Error, format!("{name} is not supported: {why}"))
+            }
         }
     }
 
@@ -144,7 +163,11 @@ impl<M: Model> Instance3<M> {
 
     /// `fmi3SetDebugLogging`.
     pub fn set_debug_logging(&mut self, on: bool, categories: &[String]) -> FmiResult {
-        self.inner.set_debug_logging(on, categories)
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.set_debug_logging(on, categories),
+        )
     }
 
     /// `fmi3EnterConfigurationMode`: `wheelsets` may be set until
@@ -191,21 +214,25 @@ impl<M: Model> Instance3<M> {
                 ),
             );
         }
-        self.inner.setup_experiment(start, stop)?;
-        self.inner.enter_initialization()
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.setup_experiment(start, stop),
+        )?;
+        fmi3(self.table, &self.running, self.inner.enter_initialization())
     }
 
     /// `fmi3ExitInitializationMode`: builds the model; the instance is then in Step
     /// Mode (there is no Event Mode).
     pub fn exit_initialization(&mut self) -> FmiResult {
         self.check(Call3::ExitInitializationMode)?;
-        self.inner.exit_initialization()
+        fmi3(self.table, &self.running, self.inner.exit_initialization())
     }
 
     /// `fmi3Terminate`.
     pub fn terminate(&mut self) -> FmiResult {
         self.check(Call3::Terminate)?;
-        self.inner.terminate()
+        fmi3(self.table, &self.running, self.inner.terminate())
     }
 
     /// `fmi3Reset`: back to the state after instantiation, start values restored
@@ -213,7 +240,7 @@ impl<M: Model> Instance3<M> {
     pub fn reset(&mut self) -> FmiResult {
         self.check(Call3::Reset)?;
         self.configuring = false;
-        self.inner.reset()
+        fmi3(self.table, &self.running, self.inner.reset())
     }
 
     // ------------------------------------------------------------ values
@@ -307,7 +334,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetFloat64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Float64], out.len())?;
-        self.inner.get_real(&e, out)
+        fmi3(self.table, &self.running, self.inner.get_real(&e, out))
     }
 
     /// `fmi3SetFloat64`.
@@ -315,7 +342,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::SetFloat64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Float64], values.len())?;
-        self.inner.set_real(&e, values)
+        fmi3(self.table, &self.running, self.inner.set_real(&e, values))
     }
 
     /// `fmi3GetInt32`.
@@ -323,7 +350,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetInt32;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Int32], out.len())?;
-        self.inner.get_integer(&e, out)
+        fmi3(self.table, &self.running, self.inner.get_integer(&e, out))
     }
 
     /// `fmi3SetInt32`.
@@ -331,7 +358,11 @@ impl<M: Model> Instance3<M> {
         let call = Call3::SetInt32;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Int32], values.len())?;
-        self.inner.set_integer(&e, values)
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.set_integer(&e, values),
+        )
     }
 
     /// `fmi3GetInt64`: the Enumerations.
@@ -340,7 +371,11 @@ impl<M: Model> Instance3<M> {
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Enumeration], out.len())?;
         let mut v = vec![0; e.len()];
-        self.inner.get_integer(&e, &mut v)?;
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.get_integer(&e, &mut v),
+        )?;
         for (o, x) in out.iter_mut().zip(v) {
             *o = x.into();
         }
@@ -358,7 +393,7 @@ impl<M: Model> Instance3<M> {
             .iter()
             .map(|&x| x.clamp(i32::MIN.into(), i32::MAX.into()) as i32)
             .collect();
-        self.inner.set_integer(&e, &v)
+        fmi3(self.table, &self.running, self.inner.set_integer(&e, &v))
     }
 
     /// `fmi3GetUInt64`: `wheelsets`, also in Instantiated and Configuration Mode.
@@ -380,7 +415,7 @@ impl<M: Model> Instance3<M> {
             .iter()
             .map(|&x| x.min(i32::MAX as u64) as i32)
             .collect();
-        self.inner.set_integer(&e, &v)
+        fmi3(self.table, &self.running, self.inner.set_integer(&e, &v))
     }
 
     /// `fmi3GetString`.
@@ -388,7 +423,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetString;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::String], n_values)?;
-        self.inner.get_string(&e)
+        fmi3(self.table, &self.running, self.inner.get_string(&e))
     }
 
     /// Keeps the C strings `fmi3GetString` handed out until the next call.
@@ -401,17 +436,14 @@ impl<M: Model> Instance3<M> {
         let call = Call3::SetString;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::String], values.len())?;
-        self.inner.set_string(&e, values)
+        fmi3(self.table, &self.running, self.inner.set_string(&e, values))
     }
 
     /// A get or set of a type no variable has (`fmi3GetBoolean`, ...): any value
     /// reference is refused, an empty request succeeds.
     pub fn no_such_type(&mut self, name: &str, get: bool, vrs: &[u32]) -> FmiResult {
-        self.check(if get {
-            Call3::GetOther
-        } else {
-            Call3::SetOther
-        })?;
+        let call = if get { Call3::GetOther } else { Call3::SetOther };
+        self.check_as(call, name)?;
         match vrs.first() {
             None => Ok(()),
             Some(&r) => {
@@ -441,7 +473,7 @@ impl<M: Model> Instance3<M> {
     pub fn do_step(&mut self, t: f64, h: f64) -> (FmiResult, StepReport) {
         let r = self
             .check(Call3::DoStep)
-            .and_then(|()| self.inner.do_step(t, h));
+            .and_then(|()| fmi3(self.table, &self.running, self.inner.do_step(t, h)));
         let report = StepReport {
             terminate: self.inner.terminated_by_model(),
             last_successful_time: self.inner.last_successful_time(),
@@ -454,22 +486,22 @@ impl<M: Model> Instance3<M> {
     /// `fmi3GetFMUState`.
     pub fn get_state(&mut self) -> FmiResult<Snapshot<M>> {
         self.check(Call3::GetFMUState)?;
-        self.inner.get_state()
+        fmi3(self.table, &self.running, self.inner.get_state())
     }
     /// `fmi3SetFMUState`.
     pub fn set_state(&mut self, s: &Snapshot<M>) -> FmiResult {
         self.check(Call3::SetFMUState)?;
         self.configuring = false;
-        self.inner.set_state(s)
+        fmi3(self.table, &self.running, self.inner.set_state(s))
     }
     /// `fmi3SerializeFMUState`'s bytes of `s`.
     pub fn serialize(&mut self, s: &Snapshot<M>) -> FmiResult<Vec<u8>> {
-        self.inner.serialize(s)
+        fmi3(self.table, &self.running, self.inner.serialize(s))
     }
     /// `fmi3DeserializeFMUState`.
     pub fn deserialize(&mut self, bytes: &[u8]) -> FmiResult<Snapshot<M>> {
         self.check(Call3::DeserializeFMUState)?;
-        self.inner.deserialize(bytes)
+        fmi3(self.table, &self.running, self.inner.deserialize(bytes))
     }
 
     // ------------------------------------------------------------ derivatives
@@ -514,8 +546,10 @@ impl<M: Model> Instance3<M> {
         let mut column = vec![0.0; u.len()];
         let mut result = vec![0.0; k.len()];
         for (s, &kj) in result.iter_mut().zip(&k) {
-            self.inner
-                .get_directional_derivative(&u, &[kj], &[1.0], &mut column)?;
+            let r = self
+                .inner
+                .get_directional_derivative(&u, &[kj], &[1.0], &mut column);
+            fmi3(self.table, &self.running, r)?;
             *s = column.iter().zip(seed).map(|(j, w)| j * w).sum();
         }
         if let Some(x) = result.iter().find(|x| !x.is_finite()) {
@@ -544,7 +578,11 @@ impl<M: Model> Instance3<M> {
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Float64], out.len())?;
         let orders: Vec<i32> = self.expand_per_element(vrs, orders);
-        self.inner.get_real_output_derivatives(&e, &orders, out)
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.get_real_output_derivatives(&e, &orders, out),
+        )
     }
 
     /// `per_variable[i]` repeated for each element in use of the variable `vrs[i]`.

@@ -4,6 +4,7 @@
 
 mod bounds;
 mod clock;
+mod fmi3;
 mod fmu_states;
 mod machine;
 mod start;

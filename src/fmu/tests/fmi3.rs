@@ -1,0 +1,254 @@
+//! The FMI 3.0 units through the Rust API of an FMI 3.0 instance: arrays of wheelsets
+//! equal the FMI 2.0 unit's variables bit for bit, `wheelsets` is set in Configuration
+//! Mode only, counts, types and calls are refused by name, the adjoint derivative is the
+//! transpose of the directional one, FMU states carry the configuration.
+
+use super::*;
+use crate::fmu::fmi3::Call3;
+use crate::fmu::vars::vr_of;
+
+fn instance3(kind: Kind) -> (Instance3, Arc<Mutex<Vec<String>>>) {
+    let log = Arc::new(Mutex::new(Vec::new()));
+    let l2 = log.clone();
+    let logger: Logger = Box::new(move |_, _, m| l2.lock().unwrap().push(m.to_string()));
+    (Instance3::new(kind.table3(), "test", logger, false), log)
+}
+
+fn v(name: &str) -> u32 {
+    vr_of(name).unwrap_or_else(|| panic!("no variable {name}"))
+}
+
+fn refused<T: std::fmt::Debug>(r: FmiResult<T>, parts: &[&str]) {
+    let e = r.expect_err("refused");
+    assert_eq!(e.status, Status::Error, "{e:?}");
+    for p in parts {
+        assert!(e.message.contains(p), "{:?} lacks {p:?}", e.message);
+    }
+}
+
+/// CoupledSystem on two wheelsets, as FMI 3.0 (configured) and FMI 2.0, initialised.
+fn two_wheelsets() -> (Instance3, Instance) {
+    let (mut a, _) = instance3(Kind::CoupledSystem);
+    a.enter_configuration().unwrap();
+    a.set_uint64(&[vr::WHEELSETS], &[2]).unwrap();
+    a.exit_configuration().unwrap();
+    a.enter_initialization(None, 0.0, None).unwrap();
+    a.exit_initialization().unwrap();
+    let (mut b, _) = instance(Kind::CoupledSystem);
+    b.set_integer(&[vr::WHEELSETS], &[2]).unwrap();
+    b.setup_experiment(0.0, None).unwrap();
+    b.enter_initialization().unwrap();
+    b.exit_initialization().unwrap();
+    (a, b)
+}
+
+#[test]
+fn an_array_of_two_wheelsets_is_the_fmi2_units_two_variables_bit_for_bit() {
+    let (mut a, mut b) = two_wheelsets();
+    let names = [
+        "contact.left.force",
+        "contact.right.force",
+        "wheel.left.z",
+        "rail.right.z",
+    ];
+    for k in 0..300 {
+        let t = k as f64 * 1e-4;
+        a.do_step(t, 1e-4).0.unwrap();
+        b.do_step(t, 1e-4).unwrap();
+    }
+    let mut x = [0.0; 8];
+    a.get_float64(&names.map(v), &mut x).unwrap();
+    let fmi2: Vec<u32> = names
+        .iter()
+        .flat_map(|n| [v(n), v(&format!("wheelset[2].{n}"))])
+        .collect();
+    let mut y = [0.0; 8];
+    b.get_real(&fmi2, &mut y).unwrap();
+    assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits));
+    // Both wheelsets carry their load: neither element is empty.
+    assert!(x[0] > 5e4 && x[1] > 5e4, "{x:?}");
+}
+
+#[test]
+fn wheelsets_is_set_in_configuration_mode_only_and_within_its_range() {
+    let (mut i, _) = instance3(Kind::TrackContact);
+    refused(
+        i.set_uint64(&[vr::WHEELSETS], &[2]),
+        &["fmi3SetUInt64", "state Instantiated", "ConfigurationMode"],
+    );
+    i.enter_configuration().unwrap();
+    refused(
+        i.set_uint64(&[vr::WHEELSETS], &[5]),
+        &["fmi3SetUInt64", "wheelsets", "5", "4"],
+    );
+    refused(
+        i.set_float64(&[vr::SPEED], &[10.0]),
+        &["fmi3SetFloat64", "ConfigurationMode"],
+    );
+    i.set_uint64(&[vr::WHEELSETS], &[3]).unwrap();
+    let mut n = [0];
+    i.get_uint64(&[vr::WHEELSETS], &mut n).unwrap();
+    assert_eq!(n, [3]);
+    i.exit_configuration().unwrap();
+    refused(
+        i.set_uint64(&[vr::WHEELSETS], &[2]),
+        &["fmi3SetUInt64", "ConfigurationMode"],
+    );
+    // Three values for an array now; a scalar one.
+    i.set_float64(
+        &[v("wheel.left.z"), vr::SPEED],
+        &[-1e-3, -1.1e-3, -1.2e-3, 20.0],
+    )
+    .unwrap();
+    assert_eq!(i.fmi2().value(v("wheelset[3].wheel.left.z")), -1.2e-3);
+    refused(
+        i.set_float64(&[v("wheel.left.z")], &[-1e-3]),
+        &["fmi3SetFloat64", "nValues = 1", "3 values", "wheelsets = 3"],
+    );
+    // A reset returns wheelsets to its start.
+    i.reset().unwrap();
+    assert_eq!(i.wheelsets(), 1);
+}
+
+#[test]
+fn a_vehicles_wheelsets_is_a_constant_and_it_has_no_configuration_mode() {
+    for (kind, n) in [(Kind::ROLL_PLANE_VEHICLE, 1), (Kind::Vehicle(2), 4)] {
+        let (mut i, _) = instance3(kind);
+        let mut x = [0];
+        i.get_uint64(&[vr::WHEELSETS], &mut x).unwrap();
+        assert_eq!(x, [n]);
+        refused(i.enter_configuration(), &["no structural parameter"]);
+        refused(i.set_uint64(&[vr::WHEELSETS], &[1]), &["fmi3SetUInt64"]);
+        i.enter_initialization(None, 0.0, None).unwrap();
+        let mut loads = vec![0.0; 2];
+        i.get_float64(&[vr::STATIC_LOAD_LEFT, vr::STATIC_LOAD_RIGHT], &mut loads)
+            .unwrap();
+        let mut z = vec![0.0; n as usize];
+        i.get_float64(&[v("wheel.left.z")], &mut z).unwrap();
+        assert!(z.iter().all(|x| x.is_finite()), "{z:?}");
+    }
+}
+
+#[test]
+fn types_references_and_calls_are_refused_by_name_in_fmi3_terms() {
+    let (mut i, _) = instance3(Kind::TrackContact);
+    refused(
+        i.set_int32(&[v("flat.left[1].shape")], &[1]),
+        &[
+            "fmi3SetInt32",
+            "flat.left[1].shape",
+            "Enumeration",
+            "fmi3SetInt64",
+        ],
+    );
+    refused(
+        i.set_int64(&[v("contact.model")], &[7]),
+        &["fmi3SetInt64", "contact.model", "7"],
+    );
+    refused(
+        i.set_int64(&[v("contact.model")], &[1 << 40]),
+        &["fmi3SetInt64", "contact.model"],
+    );
+    i.set_int64(&[v("contact.model")], &[2]).unwrap();
+    refused(
+        i.set_float64(&[crate::fmu::vars::N_VR as u32], &[0.0]),
+        &["fmi3SetFloat64", "independent variable time"],
+    );
+    refused(
+        i.get_float64(&[vr::SPEED], &mut [0.0]),
+        &["fmi3GetFloat64", "Instantiated"],
+    );
+    let (r, _) = i.do_step(0.0, 1e-3);
+    refused(
+        r,
+        &[
+            "fmi3DoStep is not allowed in state Instantiated",
+            "StepMode",
+        ],
+    );
+    refused(
+        i.check(Call3::EnterEventMode),
+        &["fmi3EnterEventMode", "no Event Mode"],
+    );
+    refused(
+        i.no_such_type("fmi3SetBoolean", false, &[vr::SPEED]),
+        &["fmi3SetBoolean", "speed", "no variable of this type"],
+    );
+    assert!(i.no_such_type("fmi3SetBoolean", false, &[]).is_ok());
+    // An FMI 2.0 layer's refusal reaches the logger in FMI 3.0 terms.
+    let (mut j, log) = instance3(Kind::TrackContact);
+    j.enter_configuration().unwrap();
+    j.set_uint64(&[vr::WHEELSETS], &[2]).unwrap();
+    j.exit_configuration().unwrap();
+    let _ = j.set_float64(&[v("wheel.left.z")], &[0.0, 1.0]);
+    let text = log.lock().unwrap().join("\n");
+    assert!(
+        text.contains("fmi3SetFloat64") && text.contains("wheel.left.z[2]"),
+        "{text}"
+    );
+    assert!(!text.contains("fmi2"), "{text}");
+}
+
+#[test]
+fn the_adjoint_derivative_is_the_transpose_of_the_directional_one() {
+    let (mut i, _) = instance3(Kind::TrackContact);
+    i.enter_configuration().unwrap();
+    i.set_uint64(&[vr::WHEELSETS], &[2]).unwrap();
+    i.exit_configuration().unwrap();
+    i.enter_initialization(None, 0.0, None).unwrap();
+    i.exit_initialization().unwrap();
+    // Before the first step the wheel heights stand for the static state (derivatives
+    // 0); after it they are the wheels'.
+    i.do_step(0.0, 1e-4).0.unwrap();
+    let unknowns = [v("contact.left.force"), v("contact.right.force")];
+    let knowns = [v("wheel.left.z"), v("wheel.right.z")];
+    // J column by column: 4 outputs (2 arrays of 2) by 4 inputs.
+    let mut j = [[0.0; 4]; 4];
+    for c in 0..4 {
+        let mut seed = [0.0; 4];
+        seed[c] = 1.0;
+        let mut col = [0.0; 4];
+        i.directional_derivative(&unknowns, &knowns, &seed, &mut col)
+            .unwrap();
+        for r in 0..4 {
+            j[r][c] = col[r];
+        }
+    }
+    // The left force of wheelset 1 depends on its own left wheel, stiffly (a wheel
+    // lifted unloads it: dP/dz = -k / (1 + c k)), and on no other wheel's height.
+    assert!(j[0][0] < -1e8 && j[3][3] < -1e8, "{j:?}");
+    assert_eq!((j[0][1], j[0][2], j[0][3]), (0.0, 0.0, 0.0), "{j:?}");
+    let w = [1.0, -2.0, 0.5, 3.0];
+    let mut adj = [0.0; 4];
+    i.adjoint_derivative(&unknowns, &knowns, &w, &mut adj)
+        .unwrap();
+    for c in 0..4 {
+        let expect: f64 = (0..4).map(|r| j[r][c] * w[r]).sum();
+        assert!((adj[c] - expect).abs() <= 1e-12 * expect.abs(), "{adj:?}");
+    }
+    refused(
+        i.adjoint_derivative(&unknowns, &knowns, &w[..3], &mut adj),
+        &["fmi3GetAdjointDerivative", "nValues = 3"],
+    );
+}
+
+#[test]
+fn an_fmu_state_carries_the_configuration_into_a_fresh_instance() {
+    let (mut a, _) = two_wheelsets();
+    a.do_step(0.0, 1e-3).0.unwrap();
+    let s = a.get_state().unwrap();
+    let bytes = a.serialize(&s).unwrap();
+    let (mut b, _) = instance3(Kind::CoupledSystem);
+    let s2 = b.deserialize(&bytes).unwrap();
+    b.set_state(&s2).unwrap();
+    assert_eq!(b.wheelsets(), 2);
+    for i in [&mut a, &mut b] {
+        i.do_step(1e-3, 1e-3).0.unwrap();
+    }
+    let (mut x, mut y) = ([0.0; 2], [0.0; 2]);
+    a.get_float64(&[v("contact.left.max_force")], &mut x)
+        .unwrap();
+    b.get_float64(&[v("contact.left.max_force")], &mut y)
+        .unwrap();
+    assert_eq!(x, y);
+}
