@@ -181,6 +181,8 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
     let desc = xml_escape(&fmu.attrs["description"]);
     let order = fmu.capability("maxOutputDerivativeOrder", "0");
     let directional = fmu.capability("providesDirectionalDerivative", "false");
+    // A model that carries a track stops where a wheel comes into contact or loses it.
+    let early = !fmu.attrs.contains_key("vehicle");
     writeln!(
         md,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<fmiModelDescription\n  \
@@ -196,7 +198,7 @@ pub fn write(table: &Table, fmu: &Fmu, version: &str) -> (String, String) {
          providesAdjointDerivatives=\"{directional}\"\n    \
          canHandleVariableCommunicationStepSize=\"true\"\n    \
          maxOutputDerivativeOrder=\"{order}\"\n    hasEventMode=\"false\"\n    \
-         providesIntermediateUpdate=\"false\"\n    mightReturnEarlyFromDoStep=\"false\"\n    \
+         providesIntermediateUpdate=\"false\"\n    mightReturnEarlyFromDoStep=\"{early}\"\n    \
          canReturnEarlyAfterIntermediateUpdate=\"false\"/>"
     )
     .unwrap();

@@ -56,6 +56,8 @@ class StandinHalfCar3(Fmi3Slave):
         self.F_box = np.array(start, dtype=float).reshape(SHAPE)
         self._forces_set = False
         dims = [Dimension(start=str(n)) for n in SHAPE]
+        # Its own getter and setter: pythonfmu3 0.3.4's default array setter calls
+        # np.reshape(v, newshape=...), a keyword NumPy 2.4 (pinned) no longer takes.
         self.register_variable(Float64(
             "F_box", causality=Fmi3Causality.input, variability=Fmi3Variability.continuous, dimensions=dims,
             description="Primary force at each axle box [wheelset][side] (wheelset 1 leading; left, right) pressing "

@@ -334,6 +334,65 @@ impl Simulation {
     /// anything moves (an endless track has no end); a value beyond the health bounds
     /// stops it with [`Error::Diverged`].
     pub fn advance_steps(&mut self, n: u64) -> Result<()> {
+        self.check_on_track(n)?;
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// [`Simulation::advance_steps`] that stops after the first step at whose end a
+    /// wheel of any wheelset has come into contact or lost it ([`Simulation::contacts`]
+    /// changed): the steps taken and, where it stopped early, the change, in words.
+    /// The contact at each step's end is the one the next step starts from (computed
+    /// once, as a master's read of the outputs computes it), so the run's bits are
+    /// [`Simulation::advance_steps`]'s.
+    pub fn advance_steps_to_contact_change(&mut self, n: u64) -> Result<(u64, Option<String>)> {
+        self.check_on_track(n)?;
+        let before = self.contacts();
+        for k in 1..=n {
+            self.step()?;
+            let now = self.contacts();
+            if now != before && k < n {
+                return Ok((k, Some(self.describe_contact_change(before, now))));
+            }
+        }
+        Ok((n, None))
+    }
+
+    /// Which wheels touch their rail now: bit `2 k` the left wheel of wheelset `k` (0 the
+    /// leading one), bit `2 k + 1` its right wheel; a wheel touches when its contact
+    /// force is positive.
+    pub fn contacts(&self) -> u64 {
+        (0..self.wheelsets.len())
+            .filter_map(|k| self.sample_of(k).map(|s| (k, s)))
+            .fold(0, |bits, (k, s)| {
+                let left = u64::from(s.contact[0].force > 0.0);
+                let right = u64::from(s.contact[1].force > 0.0);
+                bits | left << (2 * k) | right << (2 * k + 1)
+            })
+    }
+
+    #[cold]
+    fn describe_contact_change(&self, before: u64, now: u64) -> String {
+        let changed: Vec<String> = (0..2 * self.wheelsets.len())
+            .filter(|b| (before ^ now) >> b & 1 == 1)
+            .map(|b| {
+                let side = if b % 2 == 0 { "left" } else { "right" };
+                let what = if now >> b & 1 == 1 {
+                    "came into contact (an impact)"
+                } else {
+                    "lost contact"
+                };
+                format!("the {side} wheel of wheelset {} {what}", b / 2 + 1)
+            })
+            .collect();
+        format!("at t = {} s {}", self.time(), changed.join(", "))
+    }
+
+    /// Refuses with [`Error::OffTrack`] `n` steps that would carry the leading wheelset
+    /// off a fixed track.
+    fn check_on_track(&self, n: u64) -> Result<()> {
         if let (TrackState::Discrete(t), None) = (&self.track, &self.window) {
             let len = t.params().running_length();
             let t_end = self.clock.time_after(n);
@@ -346,9 +405,6 @@ impl Simulation {
                     time: t_end,
                 });
             }
-        }
-        for _ in 0..n {
-            self.step()?;
         }
         Ok(())
     }
@@ -396,6 +452,14 @@ impl Simulation {
     #[inline]
     pub fn advance_to(&mut self, plan: StepPlan) -> Result<()> {
         self.advance_steps(plan.steps as u64)
+    }
+
+    /// [`Simulation::advance_to`] that stops after the first step at whose end a wheel
+    /// came into contact or lost it ([`Simulation::advance_steps_to_contact_change`]):
+    /// the change in words where it stopped early (the time is then
+    /// [`Simulation::time`]).
+    pub fn advance_to_contact_change(&mut self, plan: StepPlan) -> Result<Option<String>> {
+        Ok(self.advance_steps_to_contact_change(plan.steps as u64)?.1)
     }
 
     /// Advances vehicle and track from `t_j` (s) with the contact forces of the

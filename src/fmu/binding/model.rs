@@ -273,50 +273,18 @@ impl Model for FmuModel {
     /// sample at the end of the step is final, so a value beyond the health bounds
     /// there fails this step.
     fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), StepError> {
-        match &mut self.engine {
-            Engine::Sim(sim) => {
-                if self.kind == Kind::TrackContact
-                    && self.master_end == 0.0
-                    && sim.time() == 0.0
-                    && let Some(dt) = fitted_step(sim, end)
-                {
-                    sim.change_dt(dt)?;
-                    self.published.step = dt;
-                }
-                let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
-                if let Some(p) = &mut self.partner {
-                    p.before_step(sim, self.last_step);
-                }
-                if let Err(mut e) = sim.advance_to(plan) {
-                    // A run beyond the health bounds that the input datum may explain
-                    // names it (issue 38, N5).
-                    let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
-                    if let (Error::Diverged { cause, .. }, Kind::TrackContact) = (&mut e, self.kind)
-                        && let Some(d) = self.datum.explain(axle_box)
-                    {
-                        cause.push_str("; ");
-                        cause.push_str(&d);
-                    }
-                    return Err(e.into());
-                }
-                // The master's step (its clock, not the track's grid).
-                self.last_step = end - self.master_end;
-                self.master_end = end;
-                self.datum.fix();
-                if let Some(p) = &mut self.partner {
-                    p.after_step(sim);
-                }
-                if self.kind == Kind::CoupledSystem {
-                    sim.check_sample()?;
-                }
-            }
-            Engine::Vehicle(u) => {
-                let plan = u.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
-                self.last_step = end - (u.time() + u.carried());
-                u.advance_to(plan)?;
-            }
-        }
-        Ok(())
+        self.advance(end, clock, false).map(|_| ())
+    }
+
+    /// A track-carrying model stops after the internal step at whose end a wheel came
+    /// into contact or lost it ([`crate::sim::Simulation::advance_to_contact_change`]);
+    /// a vehicle's FMU, which sees forces, not contact, never stops early.
+    fn advance_to_event(
+        &mut self,
+        end: f64,
+        clock: f64,
+    ) -> Result<Option<(f64, String)>, StepError> {
+        self.advance(end, clock, true)
     }
 
     fn step_fault(e: &Error) -> StepFault {
@@ -453,6 +421,75 @@ impl Model for FmuModel {
 }
 
 impl FmuModel {
+    /// [`Model::advance_to`], stopping at a change of contact when `early`
+    /// ([`Model::advance_to_event`]).
+    fn advance(
+        &mut self,
+        end: f64,
+        clock: f64,
+        early: bool,
+    ) -> Result<Option<(f64, String)>, StepError> {
+        let mut event = None;
+        match &mut self.engine {
+            Engine::Sim(sim) => {
+                if self.kind == Kind::TrackContact
+                    && self.master_end == 0.0
+                    && sim.time() == 0.0
+                    && let Some(dt) = fitted_step(sim, end)
+                {
+                    sim.change_dt(dt)?;
+                    self.published.step = dt;
+                }
+                let plan = sim.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                if let Some(p) = &mut self.partner {
+                    p.before_step(sim, self.last_step);
+                }
+                let r = if early {
+                    sim.advance_to_contact_change(plan)
+                } else {
+                    sim.advance_to(plan).map(|()| None)
+                };
+                let end = match r {
+                    Ok(Some(what)) => {
+                        let t = sim.time();
+                        event = Some((t, what));
+                        t
+                    }
+                    Ok(None) => end,
+                    Err(mut e) => {
+                        // A run beyond the health bounds that the input datum may explain
+                        // names it (issue 38, N5).
+                        let axle_box = matches!(sim.vehicle(), VehicleState::AxleBox(_));
+                        if let (Error::Diverged { cause, .. }, Kind::TrackContact) =
+                            (&mut e, self.kind)
+                            && let Some(d) = self.datum.explain(axle_box)
+                        {
+                            cause.push_str("; ");
+                            cause.push_str(&d);
+                        }
+                        return Err(e.into());
+                    }
+                };
+                // The master's step (its clock, not the track's grid).
+                self.last_step = end - self.master_end;
+                self.master_end = end;
+                self.datum.fix();
+                if let Some(p) = &mut self.partner {
+                    p.after_step(sim);
+                }
+                if self.kind == Kind::CoupledSystem {
+                    sim.check_sample()?;
+                }
+            }
+            Engine::Vehicle(u) => {
+                let plan = u.plan_to(end, clock).map_err(StepError::TooMuchWork)?;
+                self.last_step = end - (u.time() + u.carried());
+                u.advance_to(plan)?;
+            }
+        }
+        Ok(event)
+    }
+
     /// `stopTime` beyond the time the wheel reaches the end of the fixed track.
     fn unreachable_stop(&self, start: f64, stop: Option<f64>) -> Option<String> {
         let (stop, sim) = (stop?, self.simulation()?);

@@ -190,6 +190,20 @@ pub trait Model: Clone + Sized {
     /// more work than one call may; the model's errors.
     fn advance_to(&mut self, end: f64, clock: f64) -> Result<(), StepError>;
 
+    /// [`Model::advance_to`] that may stop early, at an event of the model's own (a wheel
+    /// coming into contact or losing it): the model time it stopped at (s, on its own
+    /// grid, before `end`) and the event in words; `None` where it reached `end`. For
+    /// FMI 3.0's early return (`earlyReturnAllowed`). The default never stops early.
+    ///
+    /// Errors: as [`Model::advance_to`].
+    fn advance_to_event(
+        &mut self,
+        end: f64,
+        clock: f64,
+    ) -> Result<Option<(f64, String)>, StepError> {
+        self.advance_to(end, clock).map(|()| None)
+    }
+
     /// How an error of [`Model::advance_to`] leaves the run.
     fn step_fault(e: &Error) -> StepFault;
 

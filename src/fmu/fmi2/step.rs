@@ -21,6 +21,19 @@ impl<M: Model> Instance<M> {
     /// status; one that stops it ([`StepFault::Stopped`]) gives `fmi2Error`, and the run
     /// can then only be reset or restored from an FMU state.
     pub fn do_step(&mut self, t: f64, h: f64) -> FmiResult {
+        self.step(t, h, false).map(|_| ())
+    }
+
+    /// [`Instance::do_step`] that may end early, at an event of the model's own
+    /// ([`Model::advance_to_event`]: a wheel coming into contact or losing it), for FMI
+    /// 3.0's early return: whether it did. The FMU's clock is then the model's time
+    /// there ([`Instance::last_successful_time`]), where the next step starts, and the
+    /// event is logged (`logEvents`).
+    pub fn do_step_to_event(&mut self, t: f64, h: f64) -> FmiResult<bool> {
+        self.step(t, h, true)
+    }
+
+    fn step(&mut self, t: f64, h: f64, early: bool) -> FmiResult<bool> {
         self.check(Call::DoStep)?;
         if !(h.is_finite() && h > 0.0) {
             return self.refuse(
@@ -70,7 +83,8 @@ impl<M: Model> Instance<M> {
         // (which drifts from the clock by its rounding, 1e-7 s per call at 1e9 s).
         let model_end = end - self.start_time;
         let r = match &mut self.model {
-            Some(m) => m.advance_to(model_end, clock),
+            Some(m) if early => m.advance_to_event(model_end, clock),
+            Some(m) => m.advance_to(model_end, clock).map(|()| None),
             None => Err(StepError::Model(crate::Error::Unsupported(
                 "stepping before initialisation".into(),
             ))),
@@ -86,24 +100,21 @@ impl<M: Model> Instance<M> {
                 );
             }
             Err(StepError::Model(e)) => Err(e),
-            Ok(()) => Ok(()),
+            Ok(x) => Ok(x),
         };
-        if let Err(e) = r {
-            match M::step_fault(&e) {
-                StepFault::Ended => {
-                    self.ended = true;
-                    self.phase = Phase::StepFailed;
-                }
-                // The state may be partly advanced and beyond the health bounds.
-                StepFault::Stopped => {
-                    self.failed = Some(e.to_string());
-                    self.phase = Phase::Error;
-                }
-                // Refused arguments: nothing moved.
-                StepFault::Refused => {}
-            }
-            return self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e);
+        let event = match r {
+            Ok(x) => x,
+            Err(e) => return self.step_failed(t, h, e),
+        };
+        // An early end: the model's time there, on its grid, is the FMU's clock.
+        let end = match &event {
+            Some((model_time, _)) => model_time + self.start_time,
+            None => end,
+        };
+        if let Some((_, what)) = event.as_ref() {
+            self.log_event(|| format!("returned early: {what}"));
         }
+        let early = event.is_some();
         self.time = end;
         // The step ended at stopTime (to the clock's rounding): a last step.
         let at_stop = self.stop_time.is_some_and(|s| (s - end).abs() <= clock);
@@ -123,7 +134,7 @@ impl<M: Model> Instance<M> {
             // report and returns fmi2OK, logging nothing (a warning at every step stopped
             // C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
             if !self.step_warned.fresh(w.kind, w.severity) {
-                return Ok(());
+                return Ok(early);
             }
             let message = format!("fmi2DoStep: {}", w.message);
             self.warn(&message);
@@ -132,7 +143,28 @@ impl<M: Model> Instance<M> {
                 message,
             });
         }
-        Ok(())
+        Ok(early)
+    }
+
+    /// A failed step: the run ended (`fmi2Discard`, the `fmi2Terminated` status) or
+    /// stopped (`fmi2Error`, only a reset or an FMU state goes on), or the model refused
+    /// its arguments (nothing moved).
+    #[cold]
+    fn step_failed<T>(&mut self, t: f64, h: f64, e: crate::Error) -> FmiResult<T> {
+        match M::step_fault(&e) {
+            StepFault::Ended => {
+                self.ended = true;
+                self.phase = Phase::StepFailed;
+            }
+            // The state may be partly advanced and beyond the health bounds.
+            StepFault::Stopped => {
+                self.failed = Some(e.to_string());
+                self.phase = Phase::Error;
+            }
+            // Refused arguments: nothing moved.
+            StepFault::Refused => {}
+        }
+        self.model_refusal(&format!("fmi2DoStep at t = {t} s, h = {h} s"), e)
     }
 
     /// `fmi2GetRealStatus(fmi2LastSuccessfulTime)`.

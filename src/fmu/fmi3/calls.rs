@@ -59,7 +59,9 @@ use Phase3::{
 };
 
 const ALL: &[Phase3] = &[Ins, Cnf, Ini, Stp, End, Ter, Err_];
-const READ: &[Phase3] = &[Ini, Stp, End, Ter, Err_];
+/// Where values can be read: in Instantiated the parameters' and inputs' start values
+/// (or the values set), from Initialization Mode on every variable.
+const READ: &[Phase3] = &[Ins, Ini, Stp, End, Ter, Err_];
 const WRITE: &[Phase3] = &[Ins, Ini, Stp];
 const DERIVATIVES: &[Phase3] = &[Ini, Stp, End, Ter, Err_];
 const NO_EVENTS: &str = "these units have no Event Mode (hasEventMode is false): instantiate \
@@ -139,7 +141,7 @@ pub const CALLS3: [(Call3, &str, Allowed3, Option<Call>); 43] = [
     (Call3::GetFloat64, "fmi3GetFloat64", Allowed3::In(READ), Some(Call::GetReal)),
     (Call3::GetInt32, "fmi3GetInt32", Allowed3::In(READ), Some(Call::GetInteger)),
     (Call3::GetInt64, "fmi3GetInt64", Allowed3::In(READ), Some(Call::GetInteger)),
-    (Call3::GetUInt64, "fmi3GetUInt64", Allowed3::In(&[Ins, Cnf, Ini, Stp, End, Ter, Err_]), Some(Call::GetInteger)),
+    (Call3::GetUInt64, "fmi3GetUInt64", Allowed3::In(READ), Some(Call::GetInteger)),
     (Call3::GetString, "fmi3GetString", Allowed3::In(READ), Some(Call::GetString)),
     (Call3::SetFloat64, "fmi3SetFloat64", Allowed3::In(WRITE), Some(Call::SetReal)),
     (Call3::SetInt32, "fmi3SetInt32", Allowed3::In(WRITE), Some(Call::SetInteger)),

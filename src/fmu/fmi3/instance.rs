@@ -10,6 +10,12 @@ use crate::fmu::vars::{Fmu3Table, N_VR, Type3, Var3Spec};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+/// The value reference of the independent variable `time`: the first after the
+/// table's (build/fmi3.rs).
+const TIME_VR: u32 = N_VR as u32;
+/// Its stand-in among the FMI 2.0 value references of [`Instance3::elements`].
+const TIME: u32 = u32::MAX;
+
 /// `r` of the FMI 2.0 layer with its refusal's message in FMI 3.0 terms (the logger's
 /// copy is translated on its way).
 fn fmi3<T>(table: &'static Fmu3Table, running: &AtomicUsize, r: FmiResult<T>) -> FmiResult<T> {
@@ -33,6 +39,9 @@ pub struct StepReport {
     pub terminate: bool,
     /// `lastSuccessfulTime` (s).
     pub last_successful_time: f64,
+    /// `earlyReturn`: the step ended before `t + h`, at `lastSuccessfulTime`, where a
+    /// wheel came into contact or lost it (only with early return allowed).
+    pub early_return: bool,
 }
 
 /// One FMI 3.0 instance of the model `M`.
@@ -43,6 +52,9 @@ pub struct Instance3<M: Model> {
     slot: Vec<Option<u16>>,
     /// Between `fmi3EnterConfigurationMode` and `fmi3ExitConfigurationMode`.
     configuring: bool,
+    /// `earlyReturnAllowed` of the instantiation: `fmi3DoStep` returns at a change of
+    /// contact.
+    early_return: bool,
     /// 1 + the index in [`CALLS3`] of the call running (0: none), for the logger's
     /// translation of the FMI 2.0 layer's messages.
     running: Arc<AtomicUsize>,
@@ -84,8 +96,17 @@ impl<M: Model> Instance3<M> {
             table,
             slot,
             configuring: false,
+            early_return: false,
             running,
         }
+    }
+
+    /// `earlyReturnAllowed`: from now on `fmi3DoStep` of a track-carrying FMU returns
+    /// after the internal step at whose end a wheel came into contact (an impact) or lost
+    /// it, so that a master sees it at its time ([`Model::advance_to_event`]); the
+    /// vehicles' FMUs, which see forces and not contact, never return early.
+    pub fn allow_early_return(&mut self, allowed: bool) {
+        self.early_return = allowed;
     }
 
     /// The FMU's FMI 3.0 table.
@@ -103,7 +124,11 @@ impl<M: Model> Instance3<M> {
 
     /// Logs and returns a refusal.
     pub fn refuse<T>(&mut self, status: Status, message: String) -> FmiResult<T> {
-        self.inner.refuse(status, message)
+        fmi3(
+            self.table,
+            &self.running,
+            self.inner.refuse(status, message),
+        )
     }
     /// Sends a message to the logger ([`Instance::log`]).
     pub fn log(&mut self, status: Status, category: &str, message: &str) {
@@ -261,21 +286,14 @@ impl<M: Model> Instance3<M> {
     fn var(&mut self, call: Call3, vr: u32) -> FmiResult<&'static Var3Spec> {
         match self.slot.get(vr as usize).copied().flatten() {
             Some(i) => Ok(&self.table.vars[i as usize]),
-            None => {
-                let time = if vr as usize == N_VR {
-                    " (the independent variable time, which is not read or set)"
-                } else {
-                    ""
-                };
-                self.refuse(
-                    Status::Error,
-                    format!(
-                        "{}: unknown value reference {vr}{time} for {}",
-                        call.name(),
-                        self.table.fmi2.model_identifier
-                    ),
-                )
-            }
+            None => self.refuse(
+                Status::Error,
+                format!(
+                    "{}: unknown value reference {vr} for {}",
+                    call.name(),
+                    self.table.fmi2.model_identifier
+                ),
+            ),
         }
     }
 
@@ -293,6 +311,21 @@ impl<M: Model> Instance3<M> {
         let n = self.wheelsets();
         let mut out = Vec::with_capacity(n_values);
         for &r in vrs {
+            if r == TIME_VR {
+                // The independent variable: read only (fmi3GetFloat64).
+                if call != Call3::GetFloat64 {
+                    return self.refuse(
+                        Status::Error,
+                        format!(
+                            "{}: value reference {r} is the independent variable time, which \
+                             fmi3GetFloat64 reads and nothing sets",
+                            call.name()
+                        ),
+                    );
+                }
+                out.push(TIME);
+                continue;
+            }
             let v = self.var(call, r)?;
             if !types.contains(&v.ty) {
                 let ty = match v.ty {
@@ -329,12 +362,70 @@ impl<M: Model> Instance3<M> {
         Ok(out)
     }
 
+    /// The values of the FMI 2.0 variables `e` in Instantiated (FMI 3.0, 2.3.2): a
+    /// parameter's or an input's start or the value set; any other variable is refused
+    /// (known from Initialization Mode on).
+    fn start_values<T>(
+        &mut self,
+        call: Call3,
+        e: &[u32],
+        out: &mut [T],
+        of: impl Fn(f64) -> T,
+    ) -> FmiResult {
+        use crate::fmu::vars::Causality;
+        for (o, &r) in out.iter_mut().zip(e) {
+            let spec = self
+                .table
+                .fmi2
+                .var(r)
+                .expect("an element of the FMU's table");
+            if !matches!(spec.causality, Causality::Parameter | Causality::Input) {
+                return self.refuse(
+                    Status::Error,
+                    format!(
+                        "{}: `{}` is computed by the FMU: it can be read from \
+                         fmi3EnterInitializationMode on (in Instantiated only parameters and \
+                         inputs have values)",
+                        call.name(),
+                        spec.name
+                    ),
+                );
+            }
+            *o = of(self.inner.value(r));
+        }
+        Ok(())
+    }
+
     /// `fmi3GetFloat64`.
     pub fn get_float64(&mut self, vrs: &[u32], out: &mut [f64]) -> FmiResult {
         let call = Call3::GetFloat64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Float64], out.len())?;
-        fmi3(self.table, &self.running, self.inner.get_real(&e, out))
+        if e.contains(&TIME) {
+            // The time where it is asked for, the variables' values around it.
+            let values: Vec<u32> = e.iter().copied().filter(|&r| r != TIME).collect();
+            let mut got = vec![0.0; values.len()];
+            self.get_float64_elements(call, &values, &mut got)?;
+            let mut got = got.into_iter();
+            for (o, &r) in out.iter_mut().zip(&e) {
+                *o = match r {
+                    TIME => self.inner.time(),
+                    _ => got.next().unwrap_or(f64::NAN),
+                };
+            }
+            return Ok(());
+        }
+        self.get_float64_elements(call, &e, out)
+    }
+
+    fn get_float64_elements(&mut self, call: Call3, e: &[u32], out: &mut [f64]) -> FmiResult {
+        if self.phase() == Phase3::Instantiated {
+            return self.start_values(call, e, out, |x| x);
+        }
+        if e.is_empty() {
+            return Ok(());
+        }
+        fmi3(self.table, &self.running, self.inner.get_real(e, out))
     }
 
     /// `fmi3SetFloat64`.
@@ -350,6 +441,9 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetInt32;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Int32], out.len())?;
+        if self.phase() == Phase3::Instantiated {
+            return self.start_values(call, &e, out, |x| x as i32);
+        }
         fmi3(self.table, &self.running, self.inner.get_integer(&e, out))
     }
 
@@ -370,6 +464,9 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetInt64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Enumeration], out.len())?;
+        if self.phase() == Phase3::Instantiated {
+            return self.start_values(call, &e, out, |x| x as i64);
+        }
         let mut v = vec![0; e.len()];
         fmi3(
             self.table,
@@ -423,6 +520,13 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetString;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::String], n_values)?;
+        if self.phase() == Phase3::Instantiated {
+            self.start_values(call, &e, &mut vec![0.0; e.len()], |x| x)?;
+            return Ok(e
+                .iter()
+                .map(|&r| self.inner.string(r).to_string())
+                .collect());
+        }
         fmi3(self.table, &self.running, self.inner.get_string(&e))
     }
 
@@ -442,7 +546,11 @@ impl<M: Model> Instance3<M> {
     /// A get or set of a type no variable has (`fmi3GetBoolean`, ...): any value
     /// reference is refused, an empty request succeeds.
     pub fn no_such_type(&mut self, name: &str, get: bool, vrs: &[u32]) -> FmiResult {
-        let call = if get { Call3::GetOther } else { Call3::SetOther };
+        let call = if get {
+            Call3::GetOther
+        } else {
+            Call3::SetOther
+        };
         self.check_as(call, name)?;
         match vrs.first() {
             None => Ok(()),
@@ -471,12 +579,18 @@ impl<M: Model> Instance3<M> {
     /// `fmi3DoStep` from `t` (s) by `h` (s): the FMI 2.0 layer's step, whose checks of
     /// the master's clock and warnings it keeps.
     pub fn do_step(&mut self, t: f64, h: f64) -> (FmiResult, StepReport) {
-        let r = self
-            .check(Call3::DoStep)
-            .and_then(|()| fmi3(self.table, &self.running, self.inner.do_step(t, h)));
+        let mut early = false;
+        let r = self.check(Call3::DoStep).and_then(|()| {
+            let r = match self.early_return {
+                true => self.inner.do_step_to_event(t, h).map(|e| early = e),
+                false => self.inner.do_step(t, h),
+            };
+            fmi3(self.table, &self.running, r)
+        });
         let report = StepReport {
             terminate: self.inner.terminated_by_model(),
             last_successful_time: self.inner.last_successful_time(),
+            early_return: early,
         };
         (r, report)
     }

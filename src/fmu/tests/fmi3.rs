@@ -86,10 +86,14 @@ fn wheelsets_is_set_in_configuration_mode_only_and_within_its_range() {
         &["fmi3SetFloat64", "ConfigurationMode"],
     );
     i.set_uint64(&[vr::WHEELSETS], &[3]).unwrap();
+    refused(
+        i.get_uint64(&[vr::WHEELSETS], &mut [0]),
+        &["fmi3GetUInt64", "ConfigurationMode"],
+    );
+    i.exit_configuration().unwrap();
     let mut n = [0];
     i.get_uint64(&[vr::WHEELSETS], &mut n).unwrap();
     assert_eq!(n, [3]);
-    i.exit_configuration().unwrap();
     refused(
         i.set_uint64(&[vr::WHEELSETS], &[2]),
         &["fmi3SetUInt64", "ConfigurationMode"],
@@ -104,6 +108,21 @@ fn wheelsets_is_set_in_configuration_mode_only_and_within_its_range() {
     refused(
         i.set_float64(&[v("wheel.left.z")], &[-1e-3]),
         &["fmi3SetFloat64", "nValues = 1", "3 values", "wheelsets = 3"],
+    );
+    // In Instantiated a parameter's or an input's value can be read, an output not yet.
+    let mut z = [0.0; 3];
+    i.get_float64(&[v("wheel.left.z")], &mut z).unwrap();
+    assert_eq!(z[2], -1.2e-3);
+    let mut model = [0];
+    i.get_int64(&[v("contact.model")], &mut model).unwrap();
+    assert_eq!(model, [1]);
+    refused(
+        i.get_float64(&[v("contact.left.force")], &mut z),
+        &[
+            "fmi3GetFloat64",
+            "`contact.left.force`",
+            "fmi3EnterInitializationMode",
+        ],
     );
     // A reset returns wheelsets to its start.
     i.reset().unwrap();
@@ -154,10 +173,14 @@ fn types_references_and_calls_are_refused_by_name_in_fmi3_terms() {
         i.set_float64(&[crate::fmu::vars::N_VR as u32], &[0.0]),
         &["fmi3SetFloat64", "independent variable time"],
     );
-    refused(
-        i.get_float64(&[vr::SPEED], &mut [0.0]),
-        &["fmi3GetFloat64", "Instantiated"],
-    );
+    // The time reads (among other variables) as the FMU's clock.
+    let mut t = [1.0, 1.0];
+    i.get_float64(&[crate::fmu::vars::N_VR as u32, vr::SPEED], &mut t)
+        .unwrap();
+    assert_eq!(t, [0.0, 70.0 / 3.6]);
+    let mut speed = [0.0];
+    i.get_float64(&[vr::SPEED], &mut speed).unwrap();
+    assert_eq!(speed[0], 70.0 / 3.6);
     let (r, _) = i.do_step(0.0, 1e-3);
     refused(
         r,
@@ -251,4 +274,60 @@ fn an_fmu_state_carries_the_configuration_into_a_fresh_instance() {
     b.get_float64(&[v("contact.left.max_force")], &mut y)
         .unwrap();
     assert_eq!(x, y);
+}
+
+#[test]
+fn with_early_return_a_step_ends_where_a_wheel_loses_contact_or_hits_the_rail_and_the_run_keeps_its_bits()
+ {
+    // The reference flat at 70 km/h lifts the left wheel off the rail and drops it back
+    // (the impact) once a turn. Communication steps of 20 ms, early return allowed,
+    // against the same run without it.
+    let run = |early: bool| {
+        let (mut i, log) = instance3(Kind::CoupledSystem);
+        i.allow_early_return(early);
+        i.set_debug_logging(true, &[]).unwrap();
+        i.enter_initialization(None, 0.0, Some(0.3)).unwrap();
+        i.exit_initialization().unwrap();
+        let (mut t, mut stops) = (0.0f64, Vec::new());
+        while t < 0.3 - 1e-12 {
+            let h = (0.3 - t).min(0.02);
+            let (r, rep) = i.do_step(t, h);
+            r.unwrap();
+            assert!(rep.last_successful_time > t && rep.last_successful_time <= t + h);
+            if rep.early_return {
+                assert!(rep.last_successful_time < t + h);
+                stops.push(rep.last_successful_time);
+            } else {
+                assert_eq!(rep.last_successful_time, t + h);
+            }
+            t = rep.last_successful_time;
+        }
+        let mut x = [0.0; 3];
+        i.get_float64(
+            &[
+                v("contact.left.max_force"),
+                v("contact.left.force"),
+                vr::POSITION,
+            ],
+            &mut x,
+        )
+        .unwrap();
+        let text = log.lock().unwrap().join("\n");
+        (x, stops, text)
+    };
+    let (plain, none, _) = run(false);
+    let (early, stops, text) = run(true);
+    assert!(none.is_empty());
+    assert_eq!(plain.map(f64::to_bits), early.map(f64::to_bits));
+    // Every turn of the wheel (0.475 m radius at 19.4 m/s: 0.153 s) loses contact once
+    // and hits once; at least one turn in 0.3 s.
+    assert!(stops.len() >= 2, "{stops:?}");
+    assert!(
+        text.contains("the left wheel of wheelset 1 lost contact"),
+        "{text}"
+    );
+    assert!(
+        text.contains("the left wheel of wheelset 1 came into contact (an impact)"),
+        "{text}"
+    );
 }
