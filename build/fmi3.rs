@@ -128,6 +128,9 @@ pub fn view(table: &Table, fmu: &Fmu) -> Vec<Var3> {
             array: per_wheelset,
         });
     }
+    // `wheelsets` before the arrays it sizes (FMI 3.0 sets no order, but the Reference
+    // FMUs' fmusim resolves a Dimension's reference as it reads).
+    out.sort_by_key(|x| x.v.name() != "wheelsets");
     out
 }
 
