@@ -12,8 +12,8 @@
 //!   `documentation/index.html`: what the model is, its variables, how to couple it and
 //!   its limits, from the prose of `build/pages/` and the table ([`documentation`]);
 //!   `$OUT_DIR/documentation.rs` lists them for `build_fmus`, which packs them;
-//! - `$OUT_DIR/wheelflat_fmi2.h`, the C header of the exported FMI functions, by
-//!   cbindgen ([`c_header`]).
+//! - `$OUT_DIR/wheelflat_fmi2.h` and `$OUT_DIR/wheelflat_fmi3.h`, the C headers of the
+//!   exported FMI 2.0 and FMI 3.0 functions, by cbindgen ([`c_header`]).
 //!
 //! [`table`] reads and checks the table; each generator is one file of this folder.
 
@@ -32,7 +32,7 @@ use table::{TABLE, Table};
 
 fn main() {
     println!("cargo:rerun-if-changed={TABLE}");
-    for src in c_header::FFI {
+    for src in c_header::FMI2.ffi.iter().chain(c_header::FMI3.ffi) {
         println!("cargo:rerun-if-changed={src}");
     }
     println!("cargo:rerun-if-changed=build");
@@ -69,5 +69,6 @@ fn main() {
         .unwrap();
     }
     fs::write(out.join("documentation.rs"), documentation::index(&table)).unwrap();
-    c_header::write(&out.join("wheelflat_fmi2.h"));
+    c_header::write(&c_header::FMI2, &out.join("wheelflat_fmi2.h"));
+    c_header::write(&c_header::FMI3, &out.join("wheelflat_fmi3.h"));
 }

@@ -51,9 +51,25 @@ pub fn write(table: &Table) -> String {
          the display unit is what tools may show. The range is what\n\
          `fmi2SetReal`/`fmi2SetInteger` accept (the physical ranges of `src/limits.rs`); the\n\
          engine checks the rest at `fmi2ExitInitializationMode`.\n\n\
-         | name | {heads} | type | unit (display) | start | range | description |\n\
-         |---|{rule}---|---|---|---|---|\n",
+         The FMI 3.0 units (`fmu/fmi3/`) have the same variables: the column FMI 3.0 names\n\
+         the element of an array a per-wheelset variable is there (`wheel.left.z[2]`: element\n\
+         2, wheelset 2, of the array `wheel.left.z`, one element per wheelset, the leading one\n\
+         first, sized by `wheelsets`, a UInt64 structural parameter of TC and CS set in\n\
+         Configuration Mode, a constant of each vehicle's FMU); an empty cell is the same\n\
+         name. Real is Float64 there, Integer Int32, and an enumeration an Enumeration\n\
+         (`fmi3GetInt64`, `fmi3SetInt64`).\n\n\
+         | name | {heads} | FMI 3.0 | type | unit (display) | start | range | description |\n\
+         |---|{rule}---|---|---|---|---|---|\n",
     );
+    // Each FMI 2.0 variable's FMI 3.0 element: the array's name and its 1-based index.
+    let mut fmi3: std::collections::BTreeMap<usize, String> = Default::default();
+    for f in &fmus {
+        for x in crate::fmi3::view(table, f).into_iter().filter(|x| x.array) {
+            for (k, e) in x.elements.iter().enumerate() {
+                fmi3.insert(e.vr, format!("`{}[{}]`", x.v.name(), k + 1));
+            }
+        }
+    }
     for (i, v) in table.vars.iter().enumerate() {
         let per: Vec<_> = fmus.iter().map(|f| f.var(i)).collect();
         let cols: Vec<&str> = per
@@ -87,9 +103,10 @@ pub fn write(table: &Table) -> String {
         };
         writeln!(
             md,
-            "| `{}` | {} | {ty} | {unit} | {} | {range} | {} |",
+            "| `{}` | {} | {} | {ty} | {unit} | {} | {range} | {} |",
             v.name(),
             cols.join(" | "),
+            fmi3.get(&i).map_or("", |s| s.as_str()),
             first("start"),
             v.attrs.get("description").cloned().unwrap_or_default()
         )

@@ -8,6 +8,7 @@ import ctypes
 import glob
 import html.parser
 import os
+import re
 import subprocess
 import sys
 import zipfile
@@ -55,6 +56,60 @@ def test_shared_library_exports_every_fmi2_cs_function(paths):
     out = subprocess.run(["nm", "-D", "--defined-only", lib], capture_output=True, text=True, check=True).stdout
     names = {line.split()[-1] for line in out.splitlines() if line.strip()}
     assert set(FMI2_CS_FUNCTIONS) <= names
+
+
+def official_fmi3_functions():
+    """The functions the official fmi3Functions.h (shipped with fmpy) declares: its
+    ``FMI3_Export fmi3XTYPE fmi3X;`` lines (75 of them), and the headers' folder."""
+    import fmpy
+    official = os.path.join(os.path.dirname(fmpy.__file__), "c-code")
+    text = open(os.path.join(official, "fmi3Functions.h")).read()
+    names = re.findall(r"^FMI3_Export\s+(fmi3\w+)TYPE\s+\1;", text, re.M)
+    assert len(names) == 75, names
+    return official, names
+
+
+def test_fmi3_header_compiles_against_official_fmi3Functions_h(tmp_path):
+    official, names = official_fmi3_functions()
+    header = os.path.join(wf.FMU_DIR, "include", "wheelflat_fmi3.h")
+    text = open(header).read()
+    # Every function of the standard is declared (the refused ones too), so the compiler
+    # checks each one's prototype below.
+    for f in names:
+        assert f" {f}(" in text or f"*{f}(" in text, f"{f} missing from the generated header"
+    # The header names the standard's types; the Rust types behind those names
+    # (src/fmu/ffi3/types.rs) must have their sizes (an enum's is C int's).
+    c_of = {"f32": "float", "f64": "double", "i8": "int8_t", "u8": "uint8_t", "i16": "int16_t",
+            "u16": "uint16_t", "i32": "int32_t", "u32": "uint32_t", "i64": "int64_t", "u64": "uint64_t",
+            "bool": "bool", "c_int": "int", "usize": "size_t"}
+    aliases = re.findall(r"^pub type (fmi3\w+) =\s*([^;]+);", open(os.path.join(wf.ROOT, "src/fmu/ffi3/types.rs")).read(), re.M)
+    assert len(aliases) >= 25, aliases
+    asserts = "".join(f'_Static_assert(sizeof({name}) == sizeof({c_of.get(rust, "void *")}), "{name}");\n'
+                      for name, rust in aliases)
+    src = tmp_path / "check.c"
+    src.write_text('#include "fmi3Functions.h"\n#include "wheelflat_fmi3.h"\n' + asserts + 'int main(void) { return 0; }\n')
+    r = subprocess.run(["cc", "-std=c11", "-Wall", "-Werror", "-pedantic", "-fsyntax-only",
+                        "-I", official, "-I", os.path.dirname(header), str(src)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    # A deliberately wrong declaration is caught, so the check has teeth: an enum's array
+    # as int32_t (fmi3IntervalQualifier is an enum), and a missing argument.
+    for wrong in ["fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference v[],"
+                  " size_t n, fmi3Float64 intervals[], int32_t qualifiers[]);",
+                  "fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 t, fmi3Float64 h);"]:
+        bad = tmp_path / "bad.c"
+        bad.write_text(f'#include "fmi3Functions.h"\n{wrong}\n')
+        r = subprocess.run(["cc", "-fsyntax-only", "-I", official, str(bad)], capture_output=True, text=True)
+        assert r.returncode != 0 and "conflicting types" in r.stderr, wrong
+
+
+def test_shared_library_exports_every_fmi3_function(paths):
+    _, names = official_fmi3_functions()
+    lib = glob.glob(os.path.join(wf.TARGET_DIR, "release", "libwheelflat.so"))[0]
+    out = subprocess.run(["nm", "-D", "--defined-only", lib], capture_output=True, text=True, check=True).stdout
+    exported = {line.split()[-1] for line in out.splitlines() if line.split()[1:2] == ["T"]}
+    assert set(names) - exported == set()
+    # And nothing beyond the standard under its prefix.
+    assert {n for n in exported if n.startswith("fmi3")} == set(names)
 
 
 class HtmlTables(html.parser.HTMLParser):

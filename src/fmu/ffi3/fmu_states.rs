@@ -11,11 +11,11 @@ use crate::fmu::fmi3::Call3;
 /// points to overwritten.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetFMUState(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
     let call = Call3::GetFMUState;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         if FMUState.is_null() {
             return null(&mut x.inst, call, "FMUState");
         }
@@ -32,9 +32,12 @@ pub unsafe extern "C" fn fmi3GetFMUState(
 
 /// `fmi3SetFMUState`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetFMUState(c: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
+pub unsafe extern "C" fn fmi3SetFMUState(
+    instance: fmi3Instance,
+    FMUState: fmi3FMUState,
+) -> fmi3Status {
     let call = Call3::SetFMUState;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         if FMUState.is_null() {
             return null(&mut x.inst, call, "FMUState");
         }
@@ -47,11 +50,11 @@ pub unsafe extern "C" fn fmi3SetFMUState(c: fmi3Instance, FMUState: fmi3FMUState
 /// `fmi3FreeFMUState`: `*FMUState` NULL is a no-op.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3FreeFMUState(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
     let call = Call3::FreeFMUState;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         if FMUState.is_null() {
             return null(&mut x.inst, call, "FMUState");
         }
@@ -68,12 +71,12 @@ pub unsafe extern "C" fn fmi3FreeFMUState(
 /// `fmi3SerializedFMUStateSize`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     FMUState: fmi3FMUState,
     size: *mut usize,
 ) -> fmi3Status {
     let call = Call3::SerializedFMUStateSize;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         if size.is_null() {
             return null(&mut x.inst, call, "size");
         }
@@ -89,13 +92,13 @@ pub unsafe extern "C" fn fmi3SerializedFMUStateSize(
 /// `fmi3DeserializeFMUState` takes as padding).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SerializeFMUState(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     FMUState: fmi3FMUState,
     serializedState: *mut fmi3Byte,
     size: usize,
 ) -> fmi3Status {
     let call = Call3::SerializeFMUState;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         let key = x.state(call, "FMUState", FMUState)?;
         let out = slice_mut(&mut x.inst, call, "serializedState", serializedState, size)?;
         let Inner { inst, states } = x;
@@ -124,13 +127,13 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(
 /// `*FMUState` points to overwritten.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3DeserializeFMUState(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     serializedState: *const fmi3Byte,
     size: usize,
     FMUState: *mut fmi3FMUState,
 ) -> fmi3Status {
     let call = Call3::DeserializeFMUState;
-    with_inner(c, call, |x| {
+    with_inner(instance, call, |x| {
         if FMUState.is_null() {
             return null(&mut x.inst, call, "FMUState");
         }

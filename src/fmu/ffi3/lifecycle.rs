@@ -22,13 +22,13 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
 /// `fmi3SetDebugLogging`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3SetDebugLogging(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     loggingOn: fmi3Boolean,
     nCategories: usize,
     categories: *const fmi3String,
 ) -> fmi3Status {
     let call = Call3::SetDebugLogging;
-    with(c, call, |i| {
+    with(instance, call, |i| {
         let s = slice(i, call, "categories", categories, nCategories)?;
         let mut v = Vec::new();
         for (k, &p) in s.iter().enumerate() {
@@ -82,22 +82,24 @@ pub fn kind_for_token(binary: Option<Kind>, token: &str) -> Result<Kind, String>
 }
 
 /// `fmi3InstantiateCoSimulation`: the token selects the FMU ([`kind_for_token`]). Event
-/// Mode and intermediate variables are refused (NULL, with the reason logged); early
-/// return is accepted and never taken.
+/// Mode and intermediate variables are refused (NULL, with the reason logged); with
+/// `earlyReturnAllowed` a track-carrying FMU returns early where a wheel comes into
+/// contact or loses it.
 #[unsafe(no_mangle)]
+#[allow(unused_variables)]
 pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     instanceName: fmi3String,
     instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
-    _visible: fmi3Boolean,
+    resourcePath: fmi3String,
+    visible: fmi3Boolean,
     loggingOn: fmi3Boolean,
     eventModeUsed: fmi3Boolean,
-    _earlyReturnAllowed: fmi3Boolean,
-    _requiredIntermediateVariables: *const fmi3ValueReference,
+    earlyReturnAllowed: fmi3Boolean,
+    requiredIntermediateVariables: *const fmi3ValueReference,
     nRequiredIntermediateVariables: usize,
     instanceEnvironment: fmi3InstanceEnvironment,
     logMessage: fmi3LogMessageCallback,
-    _intermediateUpdate: fmi3IntermediateUpdateCallback,
+    intermediateUpdate: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
     let r = catch_unwind(AssertUnwindSafe(|| {
         let clog = logMessage.map(|l| CLogger {
@@ -153,7 +155,11 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
             busy,
             logger: clog,
             inner: UnsafeCell::new(Inner {
-                inst: Instance3::new(kind.table3(), &name, logger, loggingOn),
+                inst: {
+                    let mut i = Instance3::new(kind.table3(), &name, logger, loggingOn);
+                    i.allow_early_return(earlyReturnAllowed);
+                    i
+                },
                 states: HashMap::new(),
             }),
         });
@@ -164,13 +170,13 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 
 /// `fmi3FreeInstance`: the instance and every FMU state it handed out.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3FreeInstance(c: fmi3Instance) {
-    if enter(c, Call3::FreeInstance).is_none() {
+pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
+    if enter(instance, Call3::FreeInstance).is_none() {
         return;
     }
     // The busy flag stays set: no call can start on the instance being freed.
     let _ = catch_unwind(AssertUnwindSafe(|| {
-        let mut comp = unsafe { Box::from_raw(c as *mut Component) };
+        let mut comp = unsafe { Box::from_raw(instance as *mut Component) };
         let inner = comp.inner.get_mut();
         let n = inner.states.len();
         inner
@@ -182,29 +188,31 @@ pub unsafe extern "C" fn fmi3FreeInstance(c: fmi3Instance) {
 
 /// `fmi3EnterConfigurationMode`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3EnterConfigurationMode(c: fmi3Instance) -> fmi3Status {
-    with(c, Call3::EnterConfigurationMode, |i| {
+pub unsafe extern "C" fn fmi3EnterConfigurationMode(instance: fmi3Instance) -> fmi3Status {
+    with(instance, Call3::EnterConfigurationMode, |i| {
         i.enter_configuration()
     })
 }
 
 /// `fmi3ExitConfigurationMode`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3ExitConfigurationMode(c: fmi3Instance) -> fmi3Status {
-    with(c, Call3::ExitConfigurationMode, |i| i.exit_configuration())
+pub unsafe extern "C" fn fmi3ExitConfigurationMode(instance: fmi3Instance) -> fmi3Status {
+    with(instance, Call3::ExitConfigurationMode, |i| {
+        i.exit_configuration()
+    })
 }
 
 /// `fmi3EnterInitializationMode`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3EnterInitializationMode(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     toleranceDefined: fmi3Boolean,
     tolerance: fmi3Float64,
     startTime: fmi3Float64,
     stopTimeDefined: fmi3Boolean,
     stopTime: fmi3Float64,
 ) -> fmi3Status {
-    with(c, Call3::EnterInitializationMode, |i| {
+    with(instance, Call3::EnterInitializationMode, |i| {
         i.log_call(|| match stopTimeDefined {
             true => {
                 format!("fmi3EnterInitializationMode(startTime={startTime}, stopTime={stopTime})")
@@ -223,20 +231,20 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
 
 /// `fmi3ExitInitializationMode`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3ExitInitializationMode(c: fmi3Instance) -> fmi3Status {
-    with(c, Call3::ExitInitializationMode, |i| {
+pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
+    with(instance, Call3::ExitInitializationMode, |i| {
         i.exit_initialization()
     })
 }
 
 /// `fmi3Terminate`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3Terminate(c: fmi3Instance) -> fmi3Status {
-    with(c, Call3::Terminate, |i| i.terminate())
+pub unsafe extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
+    with(instance, Call3::Terminate, |i| i.terminate())
 }
 
 /// `fmi3Reset`.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3Reset(c: fmi3Instance) -> fmi3Status {
-    with(c, Call3::Reset, |i| i.reset())
+pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
+    with(instance, Call3::Reset, |i| i.reset())
 }

@@ -7,21 +7,23 @@ use super::types::*;
 use crate::fmu::fmi3::Call3;
 use crate::fmu::{FmiResult, Instance3};
 
-/// `fmi3DoStep`: `terminateSimulation` when the model ended the run; never an event or
-/// an early return. The out-arguments are written whatever the status.
+/// `fmi3DoStep`: `terminateSimulation` when the model ended the run; `earlyReturn` (with
+/// early return allowed) when it stopped where a wheel came into contact or lost it;
+/// never an event. The out-arguments are written whatever the status.
 #[unsafe(no_mangle)]
+#[allow(unused_variables)]
 pub unsafe extern "C" fn fmi3DoStep(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     currentCommunicationPoint: fmi3Float64,
     communicationStepSize: fmi3Float64,
-    _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+    noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
     eventHandlingNeeded: *mut fmi3Boolean,
     terminateSimulation: *mut fmi3Boolean,
     earlyReturn: *mut fmi3Boolean,
     lastSuccessfulTime: *mut fmi3Float64,
 ) -> fmi3Status {
     let call = Call3::DoStep;
-    with(c, call, |i| {
+    with(instance, call, |i| {
         i.log_call(|| {
             format!("fmi3DoStep(t={currentCommunicationPoint}, h={communicationStepSize})")
         });
@@ -40,7 +42,7 @@ pub unsafe extern "C" fn fmi3DoStep(
         let (r, report) = i.do_step(currentCommunicationPoint, communicationStepSize);
         unsafe {
             *eventHandlingNeeded = false;
-            *earlyReturn = false;
+            *earlyReturn = report.early_return;
             *terminateSimulation = report.terminate;
             *lastSuccessfulTime = report.last_successful_time;
         }
@@ -52,7 +54,7 @@ pub unsafe extern "C" fn fmi3DoStep(
 /// `valueReferences[i]`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetOutputDerivatives(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     valueReferences: *const fmi3ValueReference,
     nValueReferences: usize,
     orders: *const fmi3Int32,
@@ -60,7 +62,7 @@ pub unsafe extern "C" fn fmi3GetOutputDerivatives(
     nValues: usize,
 ) -> fmi3Status {
     let call = Call3::GetOutputDerivatives;
-    with(c, call, |i| {
+    with(instance, call, |i| {
         let vr = slice(
             i,
             call,
@@ -76,7 +78,7 @@ pub unsafe extern "C" fn fmi3GetOutputDerivatives(
 
 #[allow(clippy::too_many_arguments)]
 unsafe fn derivative(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     call: Call3,
     unknowns: *const fmi3ValueReference,
     nUnknowns: usize,
@@ -88,7 +90,7 @@ unsafe fn derivative(
     nSensitivity: usize,
     f: impl FnOnce(&mut Instance3, &[u32], &[u32], &[f64], &mut [f64]) -> FmiResult,
 ) -> fmi3Status {
-    with(c, call, |i| {
+    with(instance, call, |i| {
         let u = slice(i, call, "unknowns", unknowns, nUnknowns)?;
         let k = slice(i, call, "knowns", knowns, nKnowns)?;
         let s = slice(i, call, "seed", seed, nSeed)?;
@@ -101,7 +103,7 @@ unsafe fn derivative(
 /// `providesDirectionalDerivatives`): `sensitivity = J seed`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     unknowns: *const fmi3ValueReference,
     nUnknowns: usize,
     knowns: *const fmi3ValueReference,
@@ -114,7 +116,7 @@ pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
     let call = Call3::GetDirectionalDerivative;
     unsafe {
         derivative(
-            c,
+            instance,
             call,
             unknowns,
             nUnknowns,
@@ -133,7 +135,7 @@ pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
 /// `sensitivity = J^T seed`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetAdjointDerivative(
-    c: fmi3Instance,
+    instance: fmi3Instance,
     unknowns: *const fmi3ValueReference,
     nUnknowns: usize,
     knowns: *const fmi3ValueReference,
@@ -146,7 +148,7 @@ pub unsafe extern "C" fn fmi3GetAdjointDerivative(
     let call = Call3::GetAdjointDerivative;
     unsafe {
         derivative(
-            c,
+            instance,
             call,
             unknowns,
             nUnknowns,
