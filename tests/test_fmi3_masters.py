@@ -16,8 +16,10 @@ src/fmilibcpp/fmi3/):
   by the FMU (nValues) and reads 0.0.
 
 So of the shipped systems only the roll-plane pair at the contact interface (one
-wheelset, every Enumeration at its default) runs in FMI 3.0; the axle-box systems need
-``interface = axle_box`` and the others more than one wheelset. It runs bit for bit as
+wheelset, every Enumeration at its default; fmu/systems/fmi3/, the packer's) runs in FMI
+3.0; the axle-box systems need ``interface = axle_box`` (the shipped FMI 3.0 SSP of the
+roll-plane pair at the axle boxes sets it as an ``ssv:Enumeration``, which ecos refuses)
+and the others more than one wheelset (no FMI 3.0 SSP: SSP 1.0 connects scalars). It runs bit for bit as
 the FMI 2.0 FMUs do. libcosim (PyPI libcosimpy 0.0.6) loads no FMI 3.0 FMU.
 
 Each master run is a subprocess of this file (``python tests/test_fmi3_masters.py
@@ -50,79 +52,7 @@ SHIPPED_PAIR = os.path.join(FMU_DIR, "systems", "TrackContact_RollPlaneVehicle_c
 LEFT_OUT = ("interface", "wheelsets", "vehicle.model")
 
 
-# ---------------------------------------------------------------------------------------
-# The FMI 3.0 SSP of the roll-plane pair at the contact interface: what the packer
-# (src/bin/build_fmus/systems.rs) would write beside the FMI 2.0 one.
-
-SSD = """<?xml version="1.0" encoding="UTF-8"?>
-<ssd:SystemStructureDescription
-    xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
-    xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
-    xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"
-    xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations"
-    name="{name}" version="1.0">
-  <ssd:System name="{name}" description="TrackContact + RollPlaneVehicle (FMI 3.0) at the contact interface, fixed step {h!r} s (the track's solver.step), endless track; one wheelset, every Enumeration at its default (ecos sets no Enumeration)">
-    <ssd:Elements>
-      <ssd:Component name="TrackContact" source="resources/TrackContact.fmu">
-        <ssd:Connectors>
-          <ssd:Connector name="wheel.left.z" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="wheel.right.z" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="wheel.rotation" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="contact.left.force" kind="output"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="contact.right.force" kind="output"><ssc:Real/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings>
-          <ssd:ParameterBinding>
-            <ssd:ParameterValues>
-              <ssv:ParameterSet version="1.0" name="wheelflat">
-                <ssv:Parameters>
-{track}
-                </ssv:Parameters>
-              </ssv:ParameterSet>
-            </ssd:ParameterValues>
-          </ssd:ParameterBinding>
-        </ssd:ParameterBindings>
-      </ssd:Component>
-      <ssd:Component name="RollPlaneVehicle" source="resources/RollPlaneVehicle.fmu">
-        <ssd:Connectors>
-          <ssd:Connector name="wheel.left.z" kind="output"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="wheel.right.z" kind="output"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="wheel.rotation" kind="output"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="contact.left.force" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="contact.right.force" kind="input"><ssc:Real/></ssd:Connector>
-        </ssd:Connectors>
-        <ssd:ParameterBindings>
-          <ssd:ParameterBinding>
-            <ssd:ParameterValues>
-              <ssv:ParameterSet version="1.0" name="wheelflat">
-                <ssv:Parameters>
-{vehicle}
-                </ssv:Parameters>
-              </ssv:ParameterSet>
-            </ssd:ParameterValues>
-          </ssd:ParameterBinding>
-        </ssd:ParameterBindings>
-      </ssd:Component>
-    </ssd:Elements>
-    <ssd:Connections>
-      <ssd:Connection startElement="RollPlaneVehicle" startConnector="wheel.left.z" endElement="TrackContact" endConnector="wheel.left.z"/>
-      <ssd:Connection startElement="RollPlaneVehicle" startConnector="wheel.right.z" endElement="TrackContact" endConnector="wheel.right.z"/>
-      <ssd:Connection startElement="RollPlaneVehicle" startConnector="wheel.rotation" endElement="TrackContact" endConnector="wheel.rotation"/>
-      <ssd:Connection startElement="TrackContact" startConnector="contact.left.force" endElement="RollPlaneVehicle" endConnector="contact.left.force"/>
-      <ssd:Connection startElement="TrackContact" startConnector="contact.right.force" endElement="RollPlaneVehicle" endConnector="contact.right.force"/>
-    </ssd:Connections>
-  </ssd:System>
-  <ssd:DefaultExperiment startTime="0.0" stopTime="0.6">
-    <ssd:Annotations>
-      <ssc:Annotation type="com.opensimulationplatform">
-        <osp:Algorithm>
-          <osp:FixedStepAlgorithm baseStepSize="{h!r}"/>
-        </osp:Algorithm>
-      </ssc:Annotation>
-    </ssd:Annotations>
-  </ssd:DefaultExperiment>
-</ssd:SystemStructureDescription>
-"""
+SHIPPED_PAIR3 = os.path.join(FMU_DIR, "systems", "fmi3", "TrackContact_RollPlaneVehicle_contact.ssp")
 
 PARAMETER = '                  <ssv:Parameter name="{}"><ssv:{} value="{}"/></ssv:Parameter>'
 
@@ -139,37 +69,6 @@ def shipped_step():
     with zipfile.ZipFile(SHIPPED_PAIR) as z:
         ssd = z.read("SystemStructure.ssd").decode()
     return float(re.search(r'<osp:FixedStepAlgorithm baseStepSize="([^"]+)"', ssd).group(1)), ssd
-
-
-def write_fmi3_pair_ssp(path, fmu3_dir):
-    """The FMI 3.0 roll-plane pair's SSP at `path`: the shipped FMI 2.0 one's components,
-    connectors, connections and parameters, the FMI 3.0 FMUs inside, less LEFT_OUT
-    (checked to be at their FMI 3.0 start values). Returns (the SSD, the step)."""
-    from fmpy import read_model_description
-
-    h, ssd2 = shipped_step()
-    params = shipped_parameters(ssd2)
-    lines = {}
-    for comp in PAIR:
-        md = {v.name: v for v in read_model_description(os.path.join(fmu3_dir, comp + ".fmu")).modelVariables}
-        kept = []
-        for name, ty, value in params[comp]:
-            v = md[name]
-            if name in LEFT_OUT:
-                assert v.type == "Enumeration" or v.causality == "structuralParameter", (comp, name, v.type)
-                assert int(v.start) == int(value), \
-                    f"{comp}.{name}: the system wants {value}, FMI 3.0 starts at {v.start}"
-                continue
-            assert v.type == "Float64" and ty == "Real", (comp, name, v.type, ty)
-            kept.append(PARAMETER.format(name, ty, value))
-        lines[comp] = "\n".join(kept)
-    ssd = SSD.format(name="TrackContact_RollPlaneVehicle_contact", h=h, track=lines["TrackContact"],
-                     vehicle=lines["RollPlaneVehicle"])
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as z:
-        z.writestr("SystemStructure.ssd", ssd)
-        for comp in PAIR:
-            z.write(os.path.join(fmu3_dir, comp + ".fmu"), f"resources/{comp}.fmu")
-    return ssd, h
 
 
 # ---------------------------------------------------------------------------------------
@@ -305,11 +204,31 @@ def fmu3():
 
 
 @pytest.fixture(scope="module")
-def pair_ssp(fmu3, tmp_path_factory):
-    """The FMI 3.0 pair's SSP, written by hand (write_fmi3_pair_ssp): (path, SSD, step)."""
-    path = str(tmp_path_factory.mktemp("fmi3_ssp") / "TrackContact_RollPlaneVehicle_contact.ssp")
-    ssd, h = write_fmi3_pair_ssp(path, os.path.dirname(fmu3["TrackContact"]))
-    return path, ssd, h
+def pair_ssp(fmu3):
+    """The shipped FMI 3.0 pair's SSP (fmu/systems/fmi3/, the packer's): (path, SSD,
+    step). Its step is the FMI 2.0 system's, its parameters the FMI 2.0 system's less
+    LEFT_OUT, which are at their FMI 3.0 start values."""
+    from fmpy import read_model_description
+
+    with zipfile.ZipFile(SHIPPED_PAIR3) as z:
+        ssd = z.read("SystemStructure.ssd").decode()
+    h = float(re.search(r'<osp:FixedStepAlgorithm baseStepSize="([^"]+)"', ssd).group(1))
+    h2, ssd2 = shipped_step()
+    assert h == h2
+    p2, p3 = shipped_parameters(ssd2), shipped_parameters(ssd)
+    for comp in PAIR:
+        md = {v.name: v for v in read_model_description(fmu3[comp]).modelVariables}
+        kept = []
+        for name, ty, value in p2[comp]:
+            v = md[name]
+            if name in LEFT_OUT:
+                assert v.type == "Enumeration" or v.causality == "structuralParameter", (comp, name, v.type)
+                assert int(v.start) == int(value), f"{comp}.{name}: the system wants {value}, FMI 3.0 starts at {v.start}"
+                continue
+            assert v.type == "Float64" and ty == "Real", (comp, name, v.type, ty)
+            kept.append((name, ty, value))
+        assert p3[comp] == kept, comp
+    return SHIPPED_PAIR3, ssd, h
 
 
 def test_coupled_system_fmi3_in_ecos_is_fmpy_fmi2_bit_for_bit(fmu3, tmp_path):
@@ -338,7 +257,7 @@ def test_coupled_system_fmi3_in_ecos_is_fmpy_fmi2_bit_for_bit(fmu3, tmp_path):
 def test_contact_pair_fmi3_in_ecos(fmu3, pair_ssp, tmp_path):
     """TrackContact + RollPlaneVehicle FMI 3.0 (arrays of one element) at the contact in
     ecos at the track's step for 0.1 s, connected by name (EcosSimulationStructure) and
-    through the hand-written SSP: both are the shipped FMI 2.0 SSP in ecos bit for bit,
+    through the shipped FMI 3.0 SSP: both are the shipped FMI 2.0 SSP in ecos bit for bit,
     start at the static load, and peak within 1 % of the monolithic CoupledSystem."""
     from fmpy import simulate_fmu
 

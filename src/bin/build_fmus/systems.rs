@@ -11,7 +11,10 @@
 //!   `org.openmodelica` annotation (OMSimulator takes the system's type from it alone
 //!   and refuses an SSP without it);
 //! - an OSP system structure, `<system>/OspSystemStructure.xml` (libcosim), its sources
-//!   `../../<modelIdentifier>.fmu`, relative to the file's folder.
+//!   `../../<modelIdentifier>.fmu`, relative to the file's folder;
+//! - for the systems on one wheelset, `fmi3/<system>.ssp`, the same of the FMI 3.0 units
+//!   ([`System::ssd3`]; SSP 1.0 connects scalars, which a wheelset's arrays are only with
+//!   one wheelset).
 //!
 //! Every component (OSP simulator) is named after its FMU's `modelIdentifier`
 //! (`TrackContact`, `RollPlaneVehicle`, ...): OMSimulator reads a parameter's leading
@@ -354,6 +357,16 @@ pub fn systems() -> Vec<System> {
     all
 }
 
+/// The name of item `value` of the enumeration parameter `s`.
+fn item_name(s: &VarSpec, value: i32) -> &'static str {
+    let item = match s.name {
+        "interface" => enums::interface::item(value.into()),
+        "vehicle.model" => enums::vehicle_model::item(value.into()),
+        n => panic!("{n}: an enumeration set in a system needs its items here"),
+    };
+    item.unwrap_or_else(|| panic!("{} = {value}: no such item", s.name))
+}
+
 /// Shortest text that reads back as the same `f64`.
 fn num(x: f64) -> String {
     format!("{x:?}")
@@ -385,6 +398,28 @@ impl System {
 
     /// `SystemStructure.ssd`.
     pub fn ssd(&self) -> String {
+        self.ssd_of(false)
+    }
+
+    /// Whether the system is on one wheelset: only then an SSP of the FMI 3.0 units (SSP
+    /// 1.0 connects scalars; a wheelset's variables are arrays in FMI 3.0, and an array of
+    /// one element is connected as one value).
+    pub fn has_fmi3_ssp(&self) -> bool {
+        wheelsets(self.vehicle) == 1
+    }
+
+    /// The `SystemStructure.ssd` of the FMI 3.0 units ([`System::has_fmi3_ssp`]): the
+    /// same, but for the parameters FMI 3.0 types otherwise. `wheelsets`, a structural
+    /// parameter set in Configuration Mode only, and an enumeration at its start value
+    /// are left out (ecos reads neither a structural parameter nor an `ssv:Enumeration`);
+    /// an enumeration set otherwise (`interface = axle_box`) is an `ssv:Enumeration` of its
+    /// item's name.
+    pub fn ssd3(&self) -> String {
+        assert!(self.has_fmi3_ssp(), "{}: no FMI 3.0 SSP", self.name);
+        self.ssd_of(true)
+    }
+
+    fn ssd_of(&self, fmi3: bool) -> String {
         let mut x = String::new();
         let _ = write!(
             x,
@@ -433,9 +468,16 @@ impl System {
 "#,
             );
             for (name, v) in values {
-                let v = match v {
-                    Value::Real(r) => format!(r#"<ssv:Real value="{}"/>"#, num(*r)),
-                    Value::Integer(i) => format!(r#"<ssv:Integer value="{i}"/>"#),
+                let v = match (v, fmi3.then(|| spec(t, name))) {
+                    (Value::Integer(_), Some(s)) if s.name == "wheelsets" => continue,
+                    (Value::Integer(i), Some(s)) if s.ty == VarType::Enumeration => {
+                        if f64::from(*i) == s.start {
+                            continue;
+                        }
+                        format!(r#"<ssv:Enumeration value="{}"/>"#, item_name(s, *i))
+                    }
+                    (Value::Real(r), _) => format!(r#"<ssv:Real value="{}"/>"#, num(*r)),
+                    (Value::Integer(i), _) => format!(r#"<ssv:Integer value="{i}"/>"#),
                 };
                 let _ = writeln!(
                     x,
@@ -564,6 +606,25 @@ pub fn write(out: &Path) -> Result<(), Box<dyn std::error::Error>> {
             z.write_all(&fmu)?;
         }
         crate::write_whole(&ssp, &z.finish()?.into_inner())?;
+        if s.has_fmi3_ssp() {
+            // The same system of the FMI 3.0 units, from fmi3/ beside the FMUs.
+            let dir3 = dir.join("fmi3");
+            std::fs::create_dir_all(&dir3)?;
+            let ssp3 = dir3.join(format!("{}.ssp", s.name));
+            let mut z = crate::zip_in_memory();
+            z.start_file("SystemStructure.ssd", deflated)?;
+            z.write_all(s.ssd3().as_bytes())?;
+            for t in [s.track, s.vehicle] {
+                let fmu = std::fs::read(out.join(format!("fmi3/{}.fmu", t.model_identifier)))?;
+                z.start_file(
+                    format!("resources/{}.fmu", t.model_identifier),
+                    SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored),
+                )?;
+                z.write_all(&fmu)?;
+            }
+            crate::write_whole(&ssp3, &z.finish()?.into_inner())?;
+            println!("{} (the FMI 3.0 units)", ssp3.display());
+        }
         let osp_dir = dir.join(&s.name);
         std::fs::create_dir_all(&osp_dir)?;
         let osp = osp_dir.join("OspSystemStructure.xml");
