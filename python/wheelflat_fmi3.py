@@ -30,7 +30,10 @@ class Unit3:
     """One FMI 3.0 instance through fmpy's FMU3Slave. Values are read and written by
     name, flat: an array gives (and takes) one value per wheelset in use."""
 
-    def __init__(self, path, instance_name, log_message=None, logging_on=False):
+    def __init__(self, path, instance_name, log_message=None, logging_on=False, early_return=False):
+        """`early_return`: instantiated with earlyReturnAllowed, so that a track-carrying
+        unit's step ends where a wheel loses contact or hits the rail (:meth:`do_step`
+        says where)."""
         from fmpy import extract, read_model_description
         from fmpy.fmi3 import FMU3Slave
 
@@ -41,7 +44,7 @@ class Unit3:
         self.vr = {n: v.valueReference for n, v in self.vars.items()}
         self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self.dir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance_name)
-        self.fmu.instantiate(loggingOn=logging_on, logMessage=log_message)
+        self.fmu.instantiate(loggingOn=logging_on, logMessage=log_message, earlyReturnAllowed=early_return)
         self.wheelsets = int(self.vars["wheelsets"].start)
 
     def size(self, name):
@@ -83,10 +86,19 @@ class Unit3:
             else:
                 self.fmu.setFloat64(vr, [float(x) for x in values])
 
+    def initialize(self, start_time=0.0, stop_time=None):
+        """Initialization Mode (at `start_time`, with `stop_time` if given); the caller
+        exchanges what it needs there (the static loads and wheel heights, as
+        :func:`run_carrier` does), then calls ``self.fmu.exitInitializationMode()``."""
+        self.fmu.enterInitializationMode(startTime=start_time, stopTime=stop_time)
+
     def do_step(self, t, h):
-        """One ``fmi3DoStep``; whether the model ended the run (terminateSimulation)."""
-        _, terminate, _, _ = self.fmu.doStep(t, h)
-        return terminate
+        """One ``fmi3DoStep`` from `t` by `h`: ``(terminate, early_return,
+        last_successful_time)``; the next step starts at `last_successful_time` (t + h
+        unless the step returned early). A master's clock that steps on the grid
+        (``t = k * h``, not summed) keeps a coupling bit for bit with CoupledSystem."""
+        _, terminate, early, last = self.fmu.doStep(t, h)
+        return terminate, early, last
 
     def close(self, terminate=True):
         """Terminates (after stepping) and frees the instance, removing its folder."""
@@ -127,7 +139,7 @@ def run_carrier(paths, model, n, stop_time, track_params=None, vehicle_params=No
         track.set_parameters(tp)
         vehicle.set_parameters(vp)
         for u in (vehicle, track):
-            u.fmu.enterInitializationMode(startTime=0.0)
+            u.initialize()
         loads = ("static_load.left", "static_load.right")
         track.set(loads, vehicle.get(*loads))
         vehicle.set(wf.HEIGHTS, track.get(*wf.HEIGHTS))

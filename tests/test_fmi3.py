@@ -148,3 +148,33 @@ def test_a_refusal_names_the_call_the_variable_and_the_allowed_values_in_fmi3_te
     assert "fmi3SetFloat64: `wheel.left.z[2]` = 0.5" in text, text
     assert "nValues = 1" in text and "wheelsets = 2" in text
     assert "fmi2" not in text, text
+
+
+def test_early_return_through_fmpy_stops_at_each_loss_and_regain_of_contact_and_keeps_the_bits(paths3):
+    """CoupledSystem instantiated with earlyReturnAllowed, 20 ms communication steps over
+    0.3 s: the steps end early where the flat lifts the wheel and where it hits the rail
+    again (each turn, 0.153 s at 70 km/h), on the engine's grid, and the run ends where
+    the same run without early return ends, bit for bit."""
+    names = ("contact.left.max_force", "contact.left.force", "wheel.left.z", "position")
+    results, stops = [], []
+    for early in (False, True):
+        u = w3.Unit3(paths3["CoupledSystem"], "cs", early_return=early)
+        try:
+            u.initialize(stop_time=0.3)
+            u.fmu.exitInitializationMode()
+            h_engine = u.get("solver.step")[0]
+            t = 0.0
+            while t < 0.3 - 1e-12:
+                terminate, returned_early, last = u.do_step(t, min(0.02, 0.3 - t))
+                assert not terminate
+                if returned_early:
+                    assert last < t + 0.02 and abs(last / h_engine - round(last / h_engine)) < 1e-6
+                    stops.append(last)
+                t = last
+            results.append(u.get(*names))
+        finally:
+            u.close()
+    assert results[0] == results[1]
+    # Two turns of the wheel: each loses contact and hits once.
+    assert len(stops) == 4, stops
+    assert 0.03 < stops[0] < stops[1] < 0.05 and 0.18 < stops[2] < stops[3] < 0.2, stops

@@ -343,21 +343,48 @@ impl Simulation {
 
     /// [`Simulation::advance_steps`] that stops after the first step at whose end a
     /// wheel of any wheelset has come into contact or lost it ([`Simulation::contacts`]
-    /// changed): the steps taken and, where it stopped early, the change, in words.
+    /// changed), or at the last step on a fixed track that `n` steps would leave: the
+    /// steps taken and, where it stopped early, why, in words.
     /// The contact at each step's end is the one the next step starts from (computed
     /// once, as a master's read of the outputs computes it), so the run's bits are
     /// [`Simulation::advance_steps`]'s.
     pub fn advance_steps_to_contact_change(&mut self, n: u64) -> Result<(u64, Option<String>)> {
-        self.check_on_track(n)?;
+        // On a fixed track, a run that would leave it stops at its last step on it
+        // instead, an early end too; with no step left, the run ends as in
+        // `advance_steps`.
+        let (n, track_end) = match self.check_on_track(n) {
+            Ok(()) => (n, false),
+            Err(e) => {
+                let (mut on, mut off) = (0, n);
+                while off - on > 1 {
+                    let mid = on + (off - on) / 2;
+                    match self.check_on_track(mid) {
+                        Ok(()) => on = mid,
+                        Err(_) => off = mid,
+                    }
+                }
+                if on == 0 {
+                    return Err(e);
+                }
+                (on, true)
+            }
+        };
         let before = self.contacts();
         for k in 1..=n {
             self.step()?;
             let now = self.contacts();
-            if now != before && k < n {
+            if now != before && (k < n || track_end) {
                 return Ok((k, Some(self.describe_contact_change(before, now))));
             }
         }
-        Ok((n, None))
+        let end = track_end.then(|| {
+            format!(
+                "at t = {} s the wheel is at the end of the fixed track's running length: a \
+                 further step ends the run",
+                self.time()
+            )
+        });
+        Ok((n, end))
     }
 
     /// Which wheels touch their rail now: bit `2 k` the left wheel of wheelset `k` (0 the

@@ -123,6 +123,19 @@ fn stripped(lib: &Path, out: &Path) -> Result<Vec<u8>, Box<dyn std::error::Error
     Ok(bytes)
 }
 
+/// The FMI 3.0 units' documentation page is the FMI 2.0 unit's with this note first: how
+/// its variables are the FMI 2.0 variables the page lists.
+const FMI3_NOTE: &str = "<p><strong>FMI 3.0 unit.</strong> This page names the FMI 2.0 unit's \
+    variables. In this FMI 3.0 unit each per-wheelset variable is one array, the leading \
+    wheelset first: <code>x</code> and <code>wheelset[k].x</code> below are the elements 1 and \
+    k of the array <code>x</code>, sized by <code>wheelsets</code> (a UInt64 structural \
+    parameter set in Configuration Mode where the FMU carries any number of wheelsets, else a \
+    constant). Real is Float64, Integer Int32, an enumeration an Enumeration (fmi3GetInt64, \
+    fmi3SetInt64); <code>time</code> is the independent variable. With earlyReturnAllowed a \
+    track-carrying unit's fmi3DoStep ends where a wheel loses contact or hits the rail. See the \
+    guide's <em>FMI 3.0 units</em> (docs/guide/fmus.md) and docs/VARIABLES.md, whose FMI 3.0 \
+    column names each element.</p>";
+
 /// The usage line of `--help`.
 const USAGE: &str = "usage: build_fmus [OUT_DIR [VARIABLES.md]]\n\
     Packs the FMUs into OUT_DIR (default fmu/ of the checkout): each FMU, the C header, the \
@@ -217,7 +230,10 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             .find(|(x, _)| *x == id)
             .ok_or_else(|| format!("no documentation page for {id}"))?;
         z.start_file("documentation/index.html", opts)?;
-        z.write_all(page.as_bytes())?;
+        z.write_all(
+            page.replacen("<body>", &format!("<body>\n{FMI3_NOTE}"), 1)
+                .as_bytes(),
+        )?;
         write_whole(&path, &z.finish()?.into_inner())?;
         println!("{} ({id} FMI 3.0 {})", path.display(), t.token);
     }

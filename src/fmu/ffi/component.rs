@@ -1,18 +1,13 @@
-//! What an `fmi2Component` points to: the instance behind a busy flag with the FMU
-//! states it handed out, the master's logger, and the wrappers every exported function
-//! runs in (claim the instance, check the state table, catch panics).
+//! The FMI 2.0 side of the C boundary's guard ([`super::guard`]): what an
+//! `fmi2Component` points to, the master's logger (FMI 2.0's, variadic, with the instance
+//! name), the wrappers every exported function runs in, and `fmi2Boolean` arguments.
 
+use super::guard::{self, Guarded, MasterLog};
+pub(super) use super::guard::{c_str, slice, slice_mut};
 use super::types::*;
 use crate::fmu::{CALLS, Call, FmiResult, Instance, Snapshot, Status};
-use std::cell::UnsafeCell;
-use std::collections::HashMap;
 use std::ffi::{CStr, CString, c_int};
-use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-pub(super) const OK: fmi2Status = Status::Ok as c_int;
-pub(super) const ERROR: fmi2Status = Status::Error as c_int;
+use std::sync::atomic::AtomicUsize;
 
 /// The master's logger with what it needs.
 #[derive(Clone)]
@@ -60,12 +55,7 @@ impl CLogger {
         category: &str,
         message: &str,
     ) {
-        match running(busy.load(Ordering::Relaxed)) {
-            Some(call) if !message.contains(call.name()) => {
-                self.log(status, category, &format!("{}: {message}", call.name()))
-            }
-            _ => self.log(status, category, message),
-        }
+        guard::log_in_call::<Instance>(self, busy, status, category, message, |_| false)
     }
 }
 
@@ -74,98 +64,66 @@ pub(super) fn running(flag: usize) -> Option<Call> {
     CALLS.get(flag.wrapping_sub(1)).map(|c| c.0)
 }
 
-/// What an `fmi2Component` points to: the instance behind a busy flag.
-///
-/// FMI 2.0 forbids calling one instance from two threads at once; a master that does
-/// gets `fmi2Error` for the second call, which touches nothing but the flag and the
-/// copy of the logger here. (`fmi2FreeInstance` racing with another call is refused
-/// the same way; a call made after `fmi2FreeInstance` returned cannot be detected.)
-pub(super) struct Component {
-    /// 0 when idle, else 1 + the index in [`CALLS`] of the function running. Shared with
-    /// the instance's logger, which names that function.
-    pub(super) busy: Arc<AtomicUsize>,
-    /// The master's logger, for refusals that must not touch the instance.
-    pub(super) logger: Option<CLogger>,
-    pub(super) inner: UnsafeCell<Inner>,
+impl MasterLog for CLogger {
+    fn log(&self, status: Status, category: &str, message: &str) {
+        CLogger::log(self, status, category, message)
+    }
 }
 
+impl Guarded for Instance {
+    type Call = Call;
+    const STANDARD: &'static str = "FMI 2.0";
+    const RESET: &'static str = "fmi2Reset";
+    const NULL_EMPTY_OK: bool = false;
+    fn call_of_flag(flag: usize) -> Option<Call> {
+        running(flag)
+    }
+    fn flag_of(call: Call) -> usize {
+        call as usize + 1
+    }
+    fn call_name(call: Call) -> &'static str {
+        call.name()
+    }
+    fn check_call(&mut self, call: Call) -> FmiResult {
+        self.check(call)
+    }
+    fn refuse_with(&mut self, status: Status, message: String) -> FmiResult {
+        self.refuse(status, message)
+    }
+    fn log_message(&mut self, status: Status, category: &str, message: &str) {
+        self.log(status, category, message)
+    }
+    fn poison_instance(&mut self) {
+        self.poison()
+    }
+    const STATE: &'static str = "FMUstate";
+    const SIZE_CALL: &'static str = "fmi2SerializedFMUstateSize";
+    fn get_state(&mut self) -> FmiResult<Snapshot> {
+        Instance::get_state(self)
+    }
+    fn set_state(&mut self, s: &Snapshot) -> FmiResult {
+        Instance::set_state(self, s)
+    }
+    fn serialize(&mut self, s: &Snapshot) -> FmiResult<Vec<u8>> {
+        Instance::serialize(self, s)
+    }
+    fn deserialize(&mut self, bytes: &[u8]) -> FmiResult<Snapshot> {
+        Instance::deserialize(self, bytes)
+    }
+    fn instance_name(&self) -> &str {
+        self.name()
+    }
+}
+
+/// What an `fmi2Component` points to: the instance behind its busy flag.
+pub(super) type Component = guard::Component<Instance, CLogger>;
 /// The instance and the FMU states it handed out.
-pub(super) struct Inner {
-    pub(super) inst: Instance,
-    /// Every FMU state handed out and not freed, by address. A state pointer is used
-    /// only when it is a key here; the rest are freed with the instance.
-    pub(super) states: HashMap<usize, Box<Snapshot>>,
-}
-
-impl Inner {
-    /// Puts `s` into the state `old` of this instance (already checked by
-    /// [`Inner::state`]), or into a new state whose address goes to `slot`.
-    pub(super) fn store(&mut self, old: Option<usize>, s: Snapshot, slot: &mut fmi2FMUstate) {
-        match old.and_then(|key| self.states.get_mut(&key)) {
-            Some(b) => **b = s,
-            None => {
-                let b = Box::new(s);
-                let p = &*b as *const Snapshot as fmi2FMUstate;
-                self.states.insert(p as usize, b);
-                *slot = p;
-            }
-        }
-    }
-
-    /// The state behind `p` when this instance handed it out and has not freed it;
-    /// `p` itself is never dereferenced.
-    pub(super) fn state(&mut self, call: Call, what: &str, p: fmi2FMUstate) -> FmiResult<usize> {
-        let key = p as usize;
-        if self.states.contains_key(&key) {
-            return Ok(key);
-        }
-        let live = self.states.len();
-        self.inst.refuse(
-            Status::Error,
-            format!(
-                "{}: argument `{what}` = {p:p} is not an FMU state of this instance \
-                 (\"{}\", {live} live states): it belongs to another instance, was already \
-                 freed, or is not an FMU state; it was not used",
-                call.name(),
-                self.inst.name()
-            ),
-        )
-    }
-}
+pub(super) type Inner = guard::Inner<Instance>;
 
 /// Claims the instance behind `c` for `call`, or refuses (busy: logged).
 #[inline]
 pub(super) fn enter<'a>(c: fmi2Component, call: Call) -> Option<&'a Component> {
-    if c.is_null() {
-        return None;
-    }
-    let comp = unsafe { &*(c as *const Component) };
-    match comp
-        .busy
-        .compare_exchange(0, call as usize + 1, Ordering::Acquire, Ordering::Acquire)
-    {
-        Ok(_) => Some(comp),
-        Err(other) => {
-            let other = running(other).map_or("another function", |o| o.name());
-            let freeing = if call == Call::FreeInstance {
-                "; the instance was not freed"
-            } else {
-                "; the call was refused and the instance left as it was"
-            };
-            if let Some(l) = &comp.logger {
-                l.log(
-                    Status::Error,
-                    "logStatusError",
-                    &format!(
-                        "{0}: instance busy: {0} called while {other} is running on another \
-                         thread{freeing} (FMI 2.0: one call at a time per instance)",
-                        call.name()
-                    ),
-                );
-            }
-            None
-        }
-    }
+    guard::enter::<Instance, CLogger>(c, call)
 }
 
 /// Runs `f` on the instance behind `c` after the state check of `call`, catching
@@ -176,40 +134,7 @@ pub(super) fn with_inner(
     call: Call,
     f: impl FnOnce(&mut Inner) -> FmiResult,
 ) -> fmi2Status {
-    let Some(comp) = enter(c, call) else {
-        return ERROR;
-    };
-    // The busy flag is ours: no other thread touches the instance until it is cleared.
-    let inner = unsafe { &mut *comp.inner.get() };
-    let r = catch_unwind(AssertUnwindSafe(|| {
-        inner.inst.check(call)?;
-        f(inner)
-    }));
-    let status = match r {
-        Ok(Ok(())) => OK,
-        Ok(Err(r)) => r.status as c_int,
-        Err(p) => {
-            let what = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                inner.inst.poison();
-                inner.inst.log(
-                    Status::Error,
-                    "logStatusError",
-                    &format!(
-                        "{}: internal error ({what}); the instance was stopped, call fmi2Reset",
-                        call.name()
-                    ),
-                );
-            }));
-            ERROR
-        }
-    };
-    comp.busy.store(0, Ordering::Release);
-    status
+    guard::with_inner::<Instance, CLogger>(c, call, true, f)
 }
 
 /// Runs `f` on the instance behind `c`; see [`with_inner`].
@@ -220,14 +145,6 @@ pub(super) fn with(
     f: impl FnOnce(&mut Instance) -> FmiResult,
 ) -> fmi2Status {
     with_inner(c, call, |x| f(&mut x.inst))
-}
-
-pub(super) fn c_str(s: fmi2String) -> Option<String> {
-    if s.is_null() {
-        None
-    } else {
-        Some(unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
-    }
 }
 
 /// The instance name as given: UTF-8 as it is, other bytes escaped (`\xff`) so that a
@@ -261,51 +178,5 @@ pub(super) fn bool_message(call: Call, what: &str, v: fmi2Boolean) -> String {
     format!(
         "{}: argument `{what}` = {v} is not an fmi2Boolean; allowed: fmi2True (1) or fmi2False (0)",
         call.name()
-    )
-}
-
-/// A slice from a C array, refusing a null pointer (also with a count of 0).
-pub(super) fn slice<'a, T>(
-    inst: &mut Instance,
-    call: Call,
-    what: &str,
-    p: *const T,
-    n: usize,
-) -> FmiResult<&'a [T]> {
-    non_null(inst, call, what, p, n)?;
-    Ok(unsafe { std::slice::from_raw_parts(p, n) })
-}
-
-/// A mutable slice from a C array; see [`slice`].
-pub(super) fn slice_mut<'a, T>(
-    inst: &mut Instance,
-    call: Call,
-    what: &str,
-    p: *mut T,
-    n: usize,
-) -> FmiResult<&'a mut [T]> {
-    non_null(inst, call, what, p, n)?;
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
-}
-
-/// Refuses a null array pointer `p` (with `n` values announced).
-fn non_null<T>(inst: &mut Instance, call: Call, what: &str, p: *const T, n: usize) -> FmiResult {
-    if p.is_null() {
-        return inst.refuse(
-            Status::Error,
-            format!(
-                "{}: argument `{what}` is a null pointer (count {n})",
-                call.name()
-            ),
-        );
-    }
-    Ok(())
-}
-
-/// A null pointer argument refused.
-pub(super) fn null(inst: &mut Instance, call: Call, what: &str) -> FmiResult {
-    inst.refuse(
-        Status::Error,
-        format!("{}: argument `{what}` is a null pointer", call.name()),
     )
 }

@@ -13,6 +13,7 @@ mod binary;
 mod component;
 mod derivatives;
 mod fmu_states;
+pub(crate) mod guard;
 mod lifecycle;
 mod stepping;
 #[cfg(test)]

@@ -137,7 +137,13 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
                  (providesIntermediateUpdate is false): allowed 0"
             ));
         }
-        let token = c_str(instantiationToken).unwrap_or_default();
+        let Some(token) = c_str(instantiationToken) else {
+            return fail(
+                "fmi3InstantiateCoSimulation: instantiationToken is a null pointer; give the \
+                 model description's instantiationToken"
+                    .into(),
+            );
+        };
         let binary = loaded_binary().as_deref().and_then(kind_of_binary);
         let kind = match kind_for_token(binary, &token) {
             Ok(k) => k,

@@ -9,7 +9,8 @@ use crate::fmu::{FmiResult, Instance3};
 
 /// `fmi3DoStep`: `terminateSimulation` when the model ended the run; `earlyReturn` (with
 /// early return allowed) when it stopped where a wheel came into contact or lost it;
-/// never an event. The out-arguments are written whatever the status.
+/// never an event. The out-arguments are written whenever the state table lets the step
+/// be tried, whatever its status.
 #[unsafe(no_mangle)]
 #[allow(unused_variables)]
 pub unsafe extern "C" fn fmi3DoStep(
@@ -71,6 +72,7 @@ pub unsafe extern "C" fn fmi3GetOutputDerivatives(
             nValueReferences,
         )?;
         let orders = slice(i, call, "orders", orders, nValueReferences)?;
+        i.check_count(call, vr, nValues, "nValues")?;
         let out = slice_mut(i, call, "values", values, nValues)?;
         i.output_derivatives(vr, orders, out)
     })
@@ -93,6 +95,14 @@ unsafe fn derivative(
     with(instance, call, |i| {
         let u = slice(i, call, "unknowns", unknowns, nUnknowns)?;
         let k = slice(i, call, "knowns", knowns, nKnowns)?;
+        // The counts before the buffers: the seed has the knowns' values (the unknowns'
+        // in the adjoint), the sensitivity the others'.
+        let (by_seed, by_sensitivity) = match call {
+            Call3::GetAdjointDerivative => (u, k),
+            _ => (k, u),
+        };
+        i.check_count(call, by_seed, nSeed, "nSeed")?;
+        i.check_count(call, by_sensitivity, nSensitivity, "nSensitivity")?;
         let s = slice(i, call, "seed", seed, nSeed)?;
         let out = slice_mut(i, call, "sensitivity", sensitivity, nSensitivity)?;
         f(i, u, k, s, out)

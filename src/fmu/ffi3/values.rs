@@ -21,6 +21,7 @@ unsafe fn get<T: std::fmt::Debug>(
 ) -> fmi3Status {
     with(instance, call, |i| {
         let vr = slice(i, call, "valueReferences", vr, nvr)?;
+        i.check_count(call, vr, n, "nValues")?;
         let values = slice_mut(i, call, "values", values, n)?;
         get(i, vr, values)?;
         i.log_call(|| format!("{}(vr={vr:?}) -> {values:?}", call.name()));
@@ -40,6 +41,7 @@ unsafe fn set<T: std::fmt::Debug>(
 ) -> fmi3Status {
     with(instance, call, |i| {
         let vr = slice(i, call, "valueReferences", vr, nvr)?;
+        i.check_count(call, vr, n, "nValues")?;
         let values = slice(i, call, "values", values, n)?;
         i.log_call(|| format!("{}(vr={vr:?}, values={values:?})", call.name()));
         set(i, vr, values)
@@ -423,6 +425,7 @@ pub unsafe extern "C" fn fmi3GetString(
             valueReferences,
             nValueReferences,
         )?;
+        i.check_count(call, vr, nValues, "nValues")?;
         let out = slice_mut(i, call, "values", values, nValues)?;
         let texts = i.get_string(vr, nValues)?;
         let buffers: Vec<std::ffi::CString> = texts
@@ -455,6 +458,8 @@ pub unsafe extern "C" fn fmi3SetString(
             valueReferences,
             nValueReferences,
         )?;
+        // The count first: the strings are read only as many as the variables have.
+        i.check_count(call, vr, nValues, "nValues")?;
         let ps = slice(i, call, "values", values, nValues)?;
         let mut texts = Vec::with_capacity(ps.len());
         for (k, &p) in ps.iter().enumerate() {

@@ -138,6 +138,7 @@ impl<M: Model> Instance<M> {
                 );
             }
         }
+        self.outputs_available(call.name())?;
         let Some(m) = &self.model else {
             return self.refuse(Status::Error, format!("{}: no model", call.name()));
         };

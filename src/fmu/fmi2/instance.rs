@@ -294,7 +294,10 @@ impl<M: Model> Instance<M> {
         if let Some(t) = stop.filter(|t| !(t.is_finite() && *t >= start)) {
             return self.refuse(
                 Status::Error,
-                format!("fmi2SetupExperiment: stopTime = {t} s; allowed: finite and >= startTime"),
+                format!(
+                    "fmi2SetupExperiment: stopTime = {t} s; allowed: finite and >= startTime \
+                     ({start} s)"
+                ),
             );
         }
         self.stop_time = stop;

@@ -173,6 +173,18 @@ impl<M: Model> Instance<M> {
                     v.name, v.min, v.max
                 ));
             }
+            // An Integer or an enumeration's code holds a whole number.
+            if known && v.ty != VarType::Real && x.fract() != 0.0 {
+                return Err(format!(
+                    "stored `{}` = {x} is not a whole number (an {})",
+                    v.name,
+                    if v.ty == VarType::Integer {
+                        "Integer"
+                    } else {
+                        "enumeration's code"
+                    }
+                ));
+            }
         }
         if let Some(k) = state.iter().position(|x| !x.is_finite()) {
             return Err(format!("model state [{k}] = {} is not finite", state[k]));

@@ -64,6 +64,28 @@ impl<M: Model> Instance<M> {
     /// calculated parameters come from the model, checked: a non-finite value stops the
     /// run, and so does a value the model's [`Model::check_output`] refuses with
     /// `stops_run`.
+    /// Refuses outputs (values or derivatives, for `call`) after the run stopped: an
+    /// internal error, or a value beyond the health bounds.
+    pub(super) fn outputs_available(&mut self, call: &str) -> FmiResult {
+        if self.phase == Phase::Error && self.failed.is_none() {
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "{call}: no outputs: an internal error stopped the instance; call fmi2Reset"
+                ),
+            );
+        }
+        if let Some(why) = &self.failed {
+            let m = format!(
+                "{call}: no outputs: the run stopped at t = {} s ({why}); call fmi2Reset or \
+                 fmi2SetFMUstate",
+                self.time
+            );
+            return self.refuse(Status::Error, m);
+        }
+        Ok(())
+    }
+
     fn get(&mut self, call: Call, vrs: &[u32], out: &mut [f64], real: bool) -> FmiResult {
         self.check(call)?;
         let call = call.name();
@@ -76,23 +98,8 @@ impl<M: Model> Instance<M> {
                 Causality::Output | Causality::CalculatedParameter
             );
         }
-        if needs_model && self.phase == Phase::Error && self.failed.is_none() {
-            return self.refuse(
-                Status::Error,
-                format!(
-                    "{call}: no outputs: an internal error stopped the instance; call fmi2Reset"
-                ),
-            );
-        }
         if needs_model {
-            if let Some(why) = &self.failed {
-                let m = format!(
-                    "{call}: no outputs: the run stopped at t = {} s ({why}); call fmi2Reset or \
-                     fmi2SetFMUstate",
-                    self.time
-                );
-                return self.refuse(Status::Error, m);
-            }
+            self.outputs_available(call)?;
             self.ensure_model()?;
         }
         let outputs = match &self.model {

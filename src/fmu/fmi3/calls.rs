@@ -59,9 +59,10 @@ use Phase3::{
 };
 
 const ALL: &[Phase3] = &[Ins, Cnf, Ini, Stp, End, Ter, Err_];
-/// Where values can be read: in Instantiated the parameters' and inputs' start values
-/// (or the values set), from Initialization Mode on every variable.
-const READ: &[Phase3] = &[Ins, Ini, Stp, End, Ter, Err_];
+/// Where values can be read: in Instantiated and Configuration Mode the parameters' and
+/// inputs' start values (or the values set; FMI 3.0 2.3.2, and the Reference-FMUs read in
+/// Configuration Mode too), from Initialization Mode on every variable.
+const READ: &[Phase3] = &[Ins, Cnf, Ini, Stp, End, Ter, Err_];
 const WRITE: &[Phase3] = &[Ins, Ini, Stp];
 const DERIVATIVES: &[Phase3] = &[Ini, Stp, End, Ter, Err_];
 const NO_EVENTS: &str = "these units have no Event Mode (hasEventMode is false): instantiate \

@@ -308,8 +308,43 @@ impl<M: Model> Instance3<M> {
         types: &[Type3],
         n_values: usize,
     ) -> FmiResult<Vec<u32>> {
+        self.elements_counted(call, vrs, types, n_values, "nValues")
+    }
+
+    /// Refuses `n_values` (the argument `count`) unless it is the number of values of
+    /// the variables `vrs` now: the C boundary asks before it takes a buffer of that
+    /// length from the master.
+    pub fn check_count(
+        &mut self,
+        call: Call3,
+        vrs: &[u32],
+        n_values: usize,
+        count: &str,
+    ) -> FmiResult {
+        const ANY: [Type3; 6] = [
+            Type3::Float64,
+            Type3::Int32,
+            Type3::Enumeration,
+            Type3::String,
+            Type3::Wheelsets,
+            Type3::Constant,
+        ];
+        self.elements_counted(call, vrs, &ANY, n_values, count)
+            .map(|_| ())
+    }
+
+    /// [`Instance3::elements`] whose count is the argument `count` (`nSeed`, say).
+    fn elements_counted(
+        &mut self,
+        call: Call3,
+        vrs: &[u32],
+        types: &[Type3],
+        n_values: usize,
+        count: &str,
+    ) -> FmiResult<Vec<u32>> {
         let n = self.wheelsets();
-        let mut out = Vec::with_capacity(n_values);
+        // Not the master's count (which may be any size_t): what the references need.
+        let mut out = Vec::with_capacity(n_values.min(4 * vrs.len()));
         for &r in vrs {
             if r == TIME_VR {
                 // The independent variable: read only (fmi3GetFloat64).
@@ -351,7 +386,7 @@ impl<M: Model> Instance3<M> {
             return self.refuse(
                 Status::Error,
                 format!(
-                    "{}: nValues = {n_values}, but the {} variables given have {} values (each \
+                    "{}: {count} = {n_values}, but the {} variables given have {} values (each \
                      array one per wheelset: wheelsets = {n})",
                     call.name(),
                     vrs.len(),
@@ -360,6 +395,14 @@ impl<M: Model> Instance3<M> {
             );
         }
         Ok(out)
+    }
+
+    /// Instantiated or Configuration Mode: the values are the parameters' and inputs'.
+    fn before_initialization(&self) -> bool {
+        matches!(
+            self.phase(),
+            Phase3::Instantiated | Phase3::ConfigurationMode
+        )
     }
 
     /// The values of the FMI 2.0 variables `e` in Instantiated (FMI 3.0, 2.3.2): a
@@ -419,7 +462,7 @@ impl<M: Model> Instance3<M> {
     }
 
     fn get_float64_elements(&mut self, call: Call3, e: &[u32], out: &mut [f64]) -> FmiResult {
-        if self.phase() == Phase3::Instantiated {
+        if self.before_initialization() {
             return self.start_values(call, e, out, |x| x);
         }
         if e.is_empty() {
@@ -441,7 +484,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetInt32;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Int32], out.len())?;
-        if self.phase() == Phase3::Instantiated {
+        if self.before_initialization() {
             return self.start_values(call, &e, out, |x| x as i32);
         }
         fmi3(self.table, &self.running, self.inner.get_integer(&e, out))
@@ -464,7 +507,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetInt64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Enumeration], out.len())?;
-        if self.phase() == Phase3::Instantiated {
+        if self.before_initialization() {
             return self.start_values(call, &e, out, |x| x as i64);
         }
         let mut v = vec![0; e.len()];
@@ -485,15 +528,45 @@ impl<M: Model> Instance3<M> {
         let call = Call3::SetInt64;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Enumeration], values.len())?;
-        // Beyond 32 bits no item's code: the FMI 2.0 layer names the items.
-        let v: Vec<i32> = values
-            .iter()
-            .map(|&x| x.clamp(i32::MIN.into(), i32::MAX.into()) as i32)
-            .collect();
+        let v = self.narrow(call, &e, values)?;
         fmi3(self.table, &self.running, self.inner.set_integer(&e, &v))
     }
 
-    /// `fmi3GetUInt64`: `wheelsets`, also in Instantiated and Configuration Mode.
+    /// `values` for the FMI 2.0 variables `e` as the 32-bit integers they are: a value
+    /// beyond 32 bits is refused as it was given, naming the variable's range.
+    fn narrow<T: Copy + TryInto<i32> + std::fmt::Display>(
+        &mut self,
+        call: Call3,
+        e: &[u32],
+        values: &[T],
+    ) -> FmiResult<Vec<i32>> {
+        let mut out = Vec::with_capacity(values.len());
+        for (&r, &x) in e.iter().zip(values) {
+            match x.try_into() {
+                Ok(v) => out.push(v),
+                Err(_) => {
+                    let spec = self
+                        .table
+                        .fmi2
+                        .var(r)
+                        .expect("an element of the FMU's table");
+                    return self.refuse(
+                        Status::Error,
+                        format!(
+                            "{}: `{}` = {x} is out of range; allowed: {} to {}",
+                            call.name(),
+                            spec.name,
+                            spec.min,
+                            spec.max
+                        ),
+                    );
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// `fmi3GetUInt64`: `wheelsets`.
     pub fn get_uint64(&mut self, vrs: &[u32], out: &mut [u64]) -> FmiResult {
         let call = Call3::GetUInt64;
         self.check(call)?;
@@ -506,12 +579,23 @@ impl<M: Model> Instance3<M> {
     /// `fmi3SetUInt64`: `wheelsets`, in Configuration Mode, within its range.
     pub fn set_uint64(&mut self, vrs: &[u32], values: &[u64]) -> FmiResult {
         let call = Call3::SetUInt64;
+        if let Some(c) = (self.table.vars.iter())
+            .find(|v| v.ty == Type3::Constant)
+            .filter(|_| !vrs.is_empty())
+        {
+            self.running.store(call as usize + 1, Ordering::Relaxed);
+            return self.refuse(
+                Status::Error,
+                format!(
+                    "fmi3SetUInt64: {} has no structural parameter: `{}` is a constant ({}), \
+                     its number of wheelsets",
+                    self.table.fmi2.model_identifier, c.name, c.constant
+                ),
+            );
+        }
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::Wheelsets], values.len())?;
-        let v: Vec<i32> = values
-            .iter()
-            .map(|&x| x.min(i32::MAX as u64) as i32)
-            .collect();
+        let v = self.narrow(call, &e, values)?;
         fmi3(self.table, &self.running, self.inner.set_integer(&e, &v))
     }
 
@@ -520,7 +604,7 @@ impl<M: Model> Instance3<M> {
         let call = Call3::GetString;
         self.check(call)?;
         let e = self.elements(call, vrs, &[Type3::String], n_values)?;
-        if self.phase() == Phase3::Instantiated {
+        if self.before_initialization() {
             self.start_values(call, &e, &mut vec![0.0; e.len()], |x| x)?;
             return Ok(e
                 .iter()
@@ -579,18 +663,24 @@ impl<M: Model> Instance3<M> {
     /// `fmi3DoStep` from `t` (s) by `h` (s): the FMI 2.0 layer's step, whose checks of
     /// the master's clock and warnings it keeps.
     pub fn do_step(&mut self, t: f64, h: f64) -> (FmiResult, StepReport) {
-        let mut early = false;
         let r = self.check(Call3::DoStep).and_then(|()| {
             let r = match self.early_return {
-                true => self.inner.do_step_to_event(t, h).map(|e| early = e),
+                true => self.inner.do_step_to_event(t, h).map(|_| ()),
                 false => self.inner.do_step(t, h),
             };
             fmi3(self.table, &self.running, r)
         });
+        // A step taken (with or without a warning) that ended before the master's
+        // t + h (which the FMU's clock is after a whole step) returned early.
+        let taken = match &r {
+            Ok(()) => true,
+            Err(e) => e.status == Status::Warning,
+        };
+        let last_successful_time = self.inner.last_successful_time();
         let report = StepReport {
             terminate: self.inner.terminated_by_model(),
-            last_successful_time: self.inner.last_successful_time(),
-            early_return: early,
+            last_successful_time,
+            early_return: taken && self.early_return && last_successful_time != t + h,
         };
         (r, report)
     }
@@ -649,8 +739,9 @@ impl<M: Model> Instance3<M> {
     ) -> FmiResult {
         let call = Call3::GetAdjointDerivative;
         self.check(call)?;
-        let u = self.elements(call, unknowns, &[Type3::Float64], seed.len())?;
-        let k = self.elements(call, knowns, &[Type3::Float64], sensitivity.len())?;
+        let f = &[Type3::Float64];
+        let u = self.elements_counted(call, unknowns, f, seed.len(), "nSeed")?;
+        let k = self.elements_counted(call, knowns, f, sensitivity.len(), "nSensitivity")?;
         if let Some(x) = seed.iter().find(|x| !x.is_finite()) {
             return self.refuse(
                 Status::Error,

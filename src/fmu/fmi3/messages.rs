@@ -4,7 +4,15 @@
 
 use super::calls::{Call3, fmi3_name};
 use crate::fmu::fmi2::CALLS;
-use crate::fmu::vars::Fmu3Table;
+use crate::fmu::vars::{FMI3_FMUS, Fmu3Table};
+
+/// The FMI 2.0 layer's phase names and the FMI 3.0 states they are
+/// ([`super::Phase3::of`]).
+const PHASES: [(&str, &str); 3] = [
+    ("StepComplete", "StepMode"),
+    ("StepFailed", "RunEnded"),
+    ("Initialization;", "InitializationMode;"),
+];
 
 /// `message` of the FMI 2.0 layer as an FMI 3.0 unit of `table` says it, during the
 /// call `running`.
@@ -13,6 +21,27 @@ pub fn translate(message: &str, running: Option<Call3>, table: &Fmu3Table) -> St
         .replace("fmi2Terminated status", "terminateSimulation")
         .replace("(fmi2Terminated)", "(terminateSimulation)")
         .replace("FMUstate", "FMUState");
+    // FMI 2.0's capability, phase and type names.
+    if m.contains("providesDirectionalDerivative is false") {
+        let flag = match running {
+            Some(Call3::GetAdjointDerivative) => "providesAdjointDerivatives",
+            _ => "providesDirectionalDerivatives",
+        };
+        m = m.replace(
+            "providesDirectionalDerivative is false",
+            &format!("{flag} is false"),
+        );
+    }
+    for (fmi2, fmi3) in PHASES {
+        m = m.replace(&format!("state {fmi2}"), &format!("state {fmi3}"));
+    }
+    m = m.replace("is not a Real ", "is not a Float64 ");
+    // An FMU's identity: its FMI 3.0 instantiation token, not its FMI 2.0 GUID.
+    for t in FMI3_FMUS {
+        if m.contains(t.fmi2.guid) {
+            m = m.replace(t.fmi2.guid, t.token);
+        }
+    }
     if m.contains("fmi2") {
         // Longest names first: fmi2GetRealOutputDerivatives before fmi2GetReal.
         let mut calls: Vec<_> = CALLS.iter().collect();
@@ -104,6 +133,20 @@ mod tests {
         assert_eq!(
             translate("fmi2Terminated status is true", None, t),
             "terminateSimulation is true"
+        );
+        assert_eq!(
+            translate(
+                "`x` (Parameter) cannot be set in state StepComplete; y is not a Real input; \
+                 providesDirectionalDerivative is false",
+                Some(Call3::GetAdjointDerivative),
+                t
+            ),
+            "`x` (Parameter) cannot be set in state StepMode; y is not a Float64 input; \
+             providesAdjointDerivatives is false"
+        );
+        assert_eq!(
+            translate(&format!("the state of {}", t.fmi2.guid), None, t),
+            format!("the state of {}", t.token)
         );
         // A name that is no array stays as it is.
         assert_eq!(

@@ -5,7 +5,7 @@
 
 use super::*;
 use crate::fmu::fmi3::Call3;
-use crate::fmu::vars::vr_of;
+use crate::fmu::vars::{Type3, vr_of};
 
 fn instance3(kind: Kind) -> (Instance3, Arc<Mutex<Vec<String>>>) {
     let log = Arc::new(Mutex::new(Vec::new()));
@@ -86,14 +86,19 @@ fn wheelsets_is_set_in_configuration_mode_only_and_within_its_range() {
         &["fmi3SetFloat64", "ConfigurationMode"],
     );
     i.set_uint64(&[vr::WHEELSETS], &[3]).unwrap();
-    refused(
-        i.get_uint64(&[vr::WHEELSETS], &mut [0]),
-        &["fmi3GetUInt64", "ConfigurationMode"],
-    );
-    i.exit_configuration().unwrap();
     let mut n = [0];
     i.get_uint64(&[vr::WHEELSETS], &mut n).unwrap();
     assert_eq!(n, [3]);
+    // Beyond 32 bits, refused as given.
+    refused(
+        i.set_uint64(&[vr::WHEELSETS], &[1 << 63]),
+        &[
+            "fmi3SetUInt64",
+            "`wheelsets` = 9223372036854775808",
+            "1 to 4",
+        ],
+    );
+    i.exit_configuration().unwrap();
     refused(
         i.set_uint64(&[vr::WHEELSETS], &[2]),
         &["fmi3SetUInt64", "ConfigurationMode"],
@@ -137,7 +142,10 @@ fn a_vehicles_wheelsets_is_a_constant_and_it_has_no_configuration_mode() {
         i.get_uint64(&[vr::WHEELSETS], &mut x).unwrap();
         assert_eq!(x, [n]);
         refused(i.enter_configuration(), &["no structural parameter"]);
-        refused(i.set_uint64(&[vr::WHEELSETS], &[1]), &["fmi3SetUInt64"]);
+        refused(
+            i.set_uint64(&[vr::WHEELSETS], &[1]),
+            &["fmi3SetUInt64", "no structural parameter", "a constant"],
+        );
         i.enter_initialization(None, 0.0, None).unwrap();
         let mut loads = vec![0.0; 2];
         i.get_float64(&[vr::STATIC_LOAD_LEFT, vr::STATIC_LOAD_RIGHT], &mut loads)
@@ -166,7 +174,12 @@ fn types_references_and_calls_are_refused_by_name_in_fmi3_terms() {
     );
     refused(
         i.set_int64(&[v("contact.model")], &[1 << 40]),
-        &["fmi3SetInt64", "contact.model"],
+        &["fmi3SetInt64", "`contact.model` = 1099511627776", "1 to 2"],
+    );
+    // A count far beyond the references' refused, not allocated.
+    refused(
+        i.elements(Call3::GetFloat64, &[vr::SPEED], &[Type3::Float64], 1 << 60),
+        &["nValues = 1152921504606846976", "1 values"],
     );
     i.set_int64(&[v("contact.model")], &[2]).unwrap();
     refused(
@@ -251,7 +264,7 @@ fn the_adjoint_derivative_is_the_transpose_of_the_directional_one() {
     }
     refused(
         i.adjoint_derivative(&unknowns, &knowns, &w[..3], &mut adj),
-        &["fmi3GetAdjointDerivative", "nValues = 3"],
+        &["fmi3GetAdjointDerivative", "nSeed = 3"],
     );
 }
 
@@ -330,4 +343,39 @@ fn with_early_return_a_step_ends_where_a_wheel_loses_contact_or_hits_the_rail_an
         text.contains("the left wheel of wheelset 1 came into contact (an impact)"),
         "{text}"
     );
+}
+
+#[test]
+fn with_early_return_a_step_past_the_fixed_tracks_end_stops_at_its_last_step_on_the_track() {
+    // The breaker's F8: a step that would carry the wheel off the fixed track ended the
+    // run where it stood; with early return it ends at the last step on the track.
+    let (mut i, _) = instance3(Kind::CoupledSystem);
+    i.allow_early_return(true);
+    i.set_float64(&[vr::TRACK_WINDOW_AHEAD], &[0.0]).unwrap();
+    i.set_int32(&[v("track.spans")], &[10]).unwrap();
+    i.enter_initialization(None, 0.0, None).unwrap();
+    i.exit_initialization().unwrap();
+    let (mut t, mut last) = (0.0, None);
+    for _ in 0..20 {
+        let (r, rep) = i.do_step(t, 0.5);
+        if rep.terminate {
+            // The next step after the end: the run ended there, nothing moved.
+            assert_eq!(r.unwrap_err().status, Status::Discard);
+            assert_eq!(rep.last_successful_time, t);
+            last = Some(t);
+            break;
+        }
+        // Near the rail end the step warns of the end's reflections.
+        if let Err(e) = r {
+            assert!(
+                e.status == Status::Warning && e.message.contains("rail end"),
+                "{e:?}"
+            );
+        }
+        assert!(rep.early_return && rep.last_successful_time > t);
+        t = rep.last_successful_time;
+    }
+    // Ten spans of 0.6 m from 1.37 m at 70 km/h: the running length ends near 0.25 s.
+    let end = last.expect("the run ended");
+    assert!(end > 0.2 && end < 0.26, "{end}");
 }

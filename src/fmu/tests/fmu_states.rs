@@ -35,6 +35,8 @@ fn a_doctored_state_is_refused_and_leaves_the_instance_as_it_was() {
     let b = i.serialize(&state).unwrap();
     let guid = i.table().guid.len();
     let time_at = MAGIC.len() + 8 + guid + 3;
+    // The values after the clock, the (empty) reason and the calculated parameters.
+    let values_at = time_at + 24 + 8 * <FmuModel as fmi2::Model>::CALCULATED + 8;
     let put = |at: usize, bytes: &[u8]| {
         let mut c = b.clone();
         c[at..at + bytes.len()].copy_from_slice(bytes);
@@ -55,6 +57,15 @@ fn a_doctored_state_is_refused_and_leaves_the_instance_as_it_was() {
         ),
         // a stepping state without its model (it would restart the model at t = 0)
         (put(time_at - 1, &[0]), "phase StepComplete without a model"),
+        // an enumeration's code that is no whole number (the breaker's F3: it panicked
+        // and stopped the instance)
+        (
+            put(
+                values_at + 8 * vr::CONTACT_MODEL as usize,
+                &1.5f64.to_le_bytes(),
+            ),
+            "`contact.model` = 1.5 is not a whole number",
+        ),
     ] {
         let e = i.deserialize(&bytes).unwrap_err();
         assert!(e.message.contains(why), "{why}: {}", e.message);
