@@ -1,11 +1,14 @@
-//! The FMI 2.0 co-simulation units: [`fmi2`], a model-independent FMI layer (state
-//! machine, value access through the variable table, clock, FMU states, logging);
-//! [`binding`], this project's models behind it, one for each FMU listed in [`Kind`];
-//! [`ffi`], the thin C boundary that only converts pointers, catches panics and
-//! forwards; and [`vars`], the variable table generated from
+//! The FMI co-simulation units: [`fmi2`], a model-independent FMI 2.0 layer (state
+//! machine, value access through the variable table, clock, FMU states, logging), and
+//! [`fmi3`], the FMI 3.0 layer over it (its state machine, arrays of wheelsets,
+//! Configuration Mode, early return); [`binding`], this project's models behind them,
+//! one for each FMU listed in [`Kind`]; [`ffi`] and [`ffi3`], the thin C boundaries that
+//! only convert pointers, catch panics and forward (one guard, `ffi/guard.rs`, serves
+//! both); and [`vars`], the variable table generated from
 //! `modelDescription/variables.xml`.
 //!
-//! The FMUs share one shared library; `fmi2Instantiate` picks the model from the GUID,
+//! The FMUs of both versions share one shared library; `fmi2Instantiate` picks the model
+//! from the GUID and `fmi3InstantiateCoSimulation` from the instantiation token, each of
 //! which identifies exactly one of them.
 
 pub mod binding;
