@@ -63,25 +63,49 @@ unsafe extern "C" fn record(
     category: fmi2String,
     message: fmi2String,
 ) {
-    let text = |p: *const c_char| {
-        if p.is_null() {
-            String::new()
-        } else {
-            unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-        }
-    };
     let log = unsafe { &*(env as *const Log) };
-    let r = Record {
+    log.push(Record {
         instance: text(name),
         status,
         category: text(category),
         message: text(message).replace("%%", "%"),
-    };
-    log.records.lock().unwrap().push(r.clone());
-    let hook = log.hook.lock().unwrap().clone();
-    if let Some(h) = hook {
-        h(&r);
+    });
+}
+
+fn text(p: *const c_char) -> String {
+    if p.is_null() {
+        String::new()
+    } else {
+        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
     }
+}
+
+impl Log {
+    /// Records `r` and calls the hook.
+    fn push(&self, r: Record) {
+        self.records.lock().unwrap().push(r.clone());
+        let hook = self.hook.lock().unwrap().clone();
+        if let Some(h) = hook {
+            h(&r);
+        }
+    }
+}
+
+/// The FMI 3.0 logger (`fmi3LogMessageCallback`, whose `instanceEnvironment` is the
+/// [`Log`]): the message is plain text (no format string) and names no instance.
+pub unsafe extern "C" fn record3(
+    env: *mut c_void,
+    status: c_int,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    let log = unsafe { &*(env as *const Log) };
+    log.push(Record {
+        instance: String::new(),
+        status,
+        category: text(category),
+        message: text(message),
+    });
 }
 
 type Plain =

@@ -1,7 +1,8 @@
 //! The arguments of the calls: sensible values near the start values and inside the
 //! ranges, and garbage (values that break things, foreign value references, booleans
 //! other than 0 and 1, state pointers that are not the instance's, corrupted
-//! serialized states).
+//! serialized states). Values, step sizes, state pointers and serialized states serve
+//! both FMI versions; FMI 3.0's value references and counts are [`crate::fmi3_args`].
 
 use crate::world::World;
 use crate::{Fault, avoided};
@@ -195,12 +196,13 @@ impl World {
         }
     }
 
-    /// The serialized bytes handed to fmi2DeSerializeFMUstate.
-    pub fn blob(&mut self) -> Vec<fmi2Byte> {
+    /// The serialized bytes handed to fmi2DeSerializeFMUstate or
+    /// fmi3DeserializeFMUState (both versions serialize the FMI 2.0 layer's state).
+    pub fn blob(&mut self) -> Vec<u8> {
         let rng = &mut self.rng;
         if self.blobs.is_empty() || rng.random_bool(0.1) {
             let n = rng.random_range(0..300);
-            return (0..n).map(|_| rng.random::<u8>() as fmi2Byte).collect();
+            return (0..n).map(|_| rng.random::<u8>()).collect();
         }
         let mut b = self.blobs[rng.random_range(0..self.blobs.len())].clone();
         match rng.random_range(0..8) {
@@ -211,14 +213,14 @@ impl World {
             1 => {
                 // A header byte (magic, GUID, phase, flags, lengths).
                 let k = rng.random_range(0..b.len().min(120));
-                b[k] = b[k].wrapping_add(rng.random_range(1..=255u8) as fmi2Byte);
+                b[k] = b[k].wrapping_add(rng.random_range(1..=255u8));
             }
             2 => b.extend_from_slice(&[0, 1, 2]),
             3 if b.len() > 40 => {
                 // A number of the body (clock, calculated values, variables, model
                 // state, or a length) replaced, on the grid of 8-byte fields after the
                 // GUID and the three flag bytes.
-                let guid_len = u64::from_le_bytes(std::array::from_fn(|k| b[22 + k] as u8));
+                let guid_len = u64::from_le_bytes(std::array::from_fn(|k| b[22 + k]));
                 let first = 22 + 8 + guid_len as usize + 3;
                 if first + 8 <= b.len() {
                     let j = rng.random_range(0..(b.len() - first) / 8);
@@ -228,9 +230,7 @@ impl World {
                         NASTY[rng.random_range(0..NASTY.len())]
                     };
                     let at = first + 8 * j;
-                    for (o, v) in b[at..at + 8].iter_mut().zip(x.to_le_bytes()) {
-                        *o = v as fmi2Byte;
-                    }
+                    b[at..at + 8].copy_from_slice(&x.to_le_bytes());
                 }
             }
             _ => {}

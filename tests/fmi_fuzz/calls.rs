@@ -1,5 +1,7 @@
-//! The call generator: which FMI function comes next, for a well-behaved master that
-//! follows the phase of the instance, or at random.
+//! The call generator of FMI 2.0: which function comes next, for a well-behaved master
+//! that follows the phase of the instance, or at random (FMI 3.0's is
+//! [`crate::fmi3_calls`]); the phase as the test follows it, and the weighted pick both
+//! generators use.
 
 use rand::Rng;
 use rand::rngs::StdRng;
@@ -9,6 +11,8 @@ use wheelflat::fmu::Call;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mirror {
     Instantiated,
+    /// FMI 3.0's Configuration Mode.
+    Configuration,
     Initialization,
     Stepping,
     Ended,
@@ -16,19 +20,21 @@ pub enum Mirror {
     Unknown,
 }
 
+/// One of the weighted items `w` (weights not all 0).
+pub fn pick<T: Copy>(rng: &mut StdRng, w: &[(T, u32)]) -> T {
+    let total: u32 = w.iter().map(|x| x.1).sum();
+    let mut x = rng.random_range(0..total);
+    for &(c, n) in w {
+        if x < n {
+            return c;
+        }
+        x -= n;
+    }
+    unreachable!()
+}
+
 /// A call a well-behaved master would make next (with valid arguments).
 pub fn next_valid_call(rng: &mut StdRng, phase: Mirror) -> Call {
-    let pick = |rng: &mut StdRng, w: &[(Call, u32)]| {
-        let total: u32 = w.iter().map(|x| x.1).sum();
-        let mut x = rng.random_range(0..total);
-        for &(c, n) in w {
-            if x < n {
-                return c;
-            }
-            x -= n;
-        }
-        unreachable!()
-    };
     match phase {
         Mirror::Instantiated => pick(
             rng,
@@ -72,7 +78,7 @@ pub fn next_valid_call(rng: &mut StdRng, phase: Mirror) -> Call {
             ],
         ),
         Mirror::Terminated => pick(rng, &[(Call::GetReal, 1), (Call::Reset, 4)]),
-        Mirror::Unknown => pick(
+        Mirror::Configuration | Mirror::Unknown => pick(
             rng,
             &[
                 (Call::EnterInitializationMode, 1),
@@ -121,13 +127,5 @@ pub fn pick_call(rng: &mut StdRng) -> Call {
         (Call::GetBooleanStatus, 2),
         (Call::GetStringStatus, 1),
     ];
-    let total: u32 = W.iter().map(|w| w.1).sum();
-    let mut x = rng.random_range(0..total);
-    for (c, w) in W {
-        if x < w {
-            return c;
-        }
-        x -= w;
-    }
-    unreachable!()
+    pick(rng, &W)
 }

@@ -1,7 +1,9 @@
-//! Making one call: its arguments from [`crate::args`], the call under the watchdog,
-//! and the checks of what it returns (outputs finite with fmi2OK, booleans 0 or 1).
+//! Making one FMI 2.0 call: its arguments from [`crate::args`], the call under the
+//! watchdog, and the checks of what it returns (outputs finite with fmi2OK, booleans 0
+//! or 1). FMI 3.0's is [`crate::fmi3_dispatch`].
 
 use crate::args::{boolean, faulty_value, nasty, refs, spec, step_size, value_for};
+use crate::fmu_state::StateOp;
 use crate::world::World;
 use rand::Rng;
 use std::ffi::c_int;
@@ -285,12 +287,14 @@ impl World {
                     }
                 }
             }
-            Call::GetFMUstate
-            | Call::SetFMUstate
-            | Call::FreeFMUstate
-            | Call::SerializedFMUstateSize
-            | Call::SerializeFMUstate
-            | Call::DeSerializeFMUstate => self.state_call(call, i, c, name, null_ptr),
+            Call::GetFMUstate => self.state_call(StateOp::Get, i, c, name, null_ptr),
+            Call::SetFMUstate => self.state_call(StateOp::Set, i, c, name, null_ptr),
+            Call::FreeFMUstate => self.state_call(StateOp::Free, i, c, name, null_ptr),
+            Call::SerializedFMUstateSize => self.state_call(StateOp::Size, i, c, name, null_ptr),
+            Call::SerializeFMUstate => self.state_call(StateOp::Serialize, i, c, name, null_ptr),
+            Call::DeSerializeFMUstate => {
+                self.state_call(StateOp::Deserialize, i, c, name, null_ptr)
+            }
             Call::GetDirectionalDerivative => {
                 let v = [0u32];
                 let mut o = [0.0];

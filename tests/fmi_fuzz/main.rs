@@ -1,35 +1,55 @@
-//! Property test of the C boundary: random sequences of FMI 2.0 co-simulation calls,
-//! valid and invalid, on all three FMUs with several instances alive at once, through
-//! the exported `extern "C"` functions in this process.
+//! Property test of the C boundary: random sequences of FMI 2.0 and FMI 3.0
+//! co-simulation calls, valid and invalid, on all six FMUs with several instances alive
+//! at once (FMI 2.0 and FMI 3.0 instances side by side), through the exported
+//! `extern "C"` functions in this process.
 //!
 //! Asserted for every call: it returns within [`CALL_LIMIT`] (watchdog thread); no panic
-//! escapes and none is caught inside (no "internal error" message); `fmi2GetReal`
-//! never returns NaN or an infinity with fmi2OK; every fmi2Warning / fmi2Discard /
-//! fmi2Error is logged with a message that names the function and gives a cause
-//! (calls on a null `fmi2Component`, which has no logger, excepted); only the statuses
-//! fmi2OK, fmi2Warning, fmi2Discard and fmi2Error are returned. For every sequence, a
-//! reference instance driven by a fixed valid sequence between the random calls gives
-//! bit-identical outputs to the same sequence run alone.
+//! escapes and none is caught inside (no "internal error" message); `fmi2GetReal` and
+//! `fmi3GetFloat64` never return NaN or an infinity with OK (nor do the FMI 3.0
+//! derivatives); every Warning / Discard / Error is logged with a message that names
+//! the function and gives a cause (calls on a null instance, which has no logger, and
+//! FMI 3.0 instances made without a logger excepted); an FMI 3.0 instance's messages
+//! name FMI 3.0 functions only (no `fmi2...`, no `fmi3...` that FMI 3.0 does not have);
+//! only the statuses OK, Warning, Discard and Error are returned, Error by every
+//! function FMI 3.0 units refuse (Model Exchange, Scheduled Execution, Event Mode,
+//! clocks); an FMI 3.0 instantiation makes an instance exactly when its arguments are
+//! valid; `fmi3DoStep`'s out-arguments agree with the step. For every sequence, a
+//! reference instance (FMI 2.0 or FMI 3.0, as the sequence) driven by a fixed valid
+//! sequence between the random calls gives bit-identical outputs to the same sequence
+//! run alone.
+//!
+//! Sequences 0 to [`SEQUENCES`] - 1 drive FMI 2.0 instances; sequences [`FMI3_BASE`] to
+//! [`FMI3_BASE`] + [`SEQUENCES3`] - 1 drive mostly FMI 3.0 instances ([`FMI3_SHARE`]),
+//! the others FMI 2.0 ones, in the same sequence.
 //!
 //! `cargo test --release --test fmi_fuzz`; environment:
 //! - `WHEELFLAT_FUZZ_SEED=<u64>`: base seed (default fixed; printed on failure);
-//! - `WHEELFLAT_FUZZ_SCALE=<f64>`: number of sequences times this (10 to run longer,
-//!   0.05 under valgrind);
-//! - `WHEELFLAT_FUZZ_SEQUENCE=<n>`: run only sequence n (to replay a failure);
+//! - `WHEELFLAT_FUZZ_SCALE=<f64>`: number of sequences of both parts times this (10 to
+//!   run longer, 0.05 under valgrind);
+//! - `WHEELFLAT_FUZZ_PART=fmi2` or `fmi3`: only that part's sequences;
+//! - `WHEELFLAT_FUZZ_SEQUENCE=<n>` (or `<a>..<b>`): run only sequence n (to replay a
+//!   failure; the FMI 3.0 part's from [`FMI3_BASE`] on), or sequences a to b - 1 in
+//!   order;
+//! - `WHEELFLAT_FUZZ_WORKERS=<n>`: worker threads (default [`WORKERS`]; 1 runs the
+//!   sequences one after the other on one thread: a sequence replayed alone makes the
+//!   same calls unless its path depends on a freed FMU state's address being handed out
+//!   again, which depends on what the thread allocated before);
 //! - `WHEELFLAT_FUZZ_CALL_LIMIT=<s>`: the watchdog's limit on one call (default
 //!   [`CALL_LIMIT`], 20 s; 400 under valgrind, which runs a 1 s step of CoupledSystem
 //!   in about 20 s);
-//! - `WHEELFLAT_FUZZ_TRACE=1`: print every call before it is made;
+//! - `WHEELFLAT_FUZZ_TRACE=1`: print every call before it is made (2: and the messages
+//!   it logged after it);
 //! - `WHEELFLAT_FUZZ_STOP_AT=<n>`: print the variables of every instance before call
 //!   n of the sequence, and stop;
 //! - `WHEELFLAT_FUZZ_KNOWN_FAULTS=all` (or names: `SubnormalStep,TinySolverDt`): also
-//!   generate the inputs of those [`KNOWN_ENGINE_FAULTS`].
+//!   generate the inputs of those [`KNOWN_FAULTS`].
 //!
-//! The test crate: [`calls`] picks the functions, [`args`] their arguments (valid and
-//! garbage), [`dispatch`] and [`fmu_state`] make the calls and check what each returns,
-//! [`checks`] the messages and statuses of every call, [`world`] holds the instances
-//! of a sequence, [`reference`] the reference instance and its run alone, [`stats`]
-//! the counts printed at the end.
+//! The test crate: [`calls`] and [`fmi3_calls`] pick the functions of each version,
+//! [`args`] and [`fmi3_args`] their arguments (valid and garbage), [`dispatch`],
+//! [`fmi3_dispatch`] and [`fmi3_refused`] make the calls and check what each returns,
+//! [`fmu_state`] the FMU-state calls of both versions, [`checks`] the messages and
+//! statuses of every call, [`world`] holds the instances of a sequence, [`reference`]
+//! the reference instance and its run alone, [`stats`] the counts printed at the end.
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -48,27 +68,39 @@ mod args;
 mod calls;
 mod checks;
 mod dispatch;
+mod fmi3_args;
+mod fmi3_calls;
+mod fmi3_dispatch;
+mod fmi3_refused;
 mod fmu_state;
 mod reference;
 mod stats;
 mod world;
 
 use rand::Rng;
-use rand::SeedableRng;
-use rand::rngs::StdRng;
 use reference::{Reference, alone};
 use stats::Stats;
-use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 use wheelflat::fmu::vars::FMUS;
-use world::{Beat, World};
+use world::{Beat, Version, World};
 
-/// Sequences per run (times `WHEELFLAT_FUZZ_SCALE`): 1,500 (3,000 until issue 29's last
-/// stop, which brought the test command back under 15 minutes on this project's 2-core
-/// machine; `WHEELFLAT_FUZZ_SCALE=2` runs the old 3,000).
+/// FMI 2.0 sequences per run (times `WHEELFLAT_FUZZ_SCALE`): 1,500 (3,000 until issue
+/// 29's last stop, which brought the test command back under 15 minutes on this
+/// project's 2-core machine; `WHEELFLAT_FUZZ_SCALE=2` runs the old 3,000), on all six
+/// FMUs (the first three only from the registry of six until issue 43: `FMUS[0..3]`
+/// had been TrackContact, RollPlaneVehicle and CoupledSystem).
 const SEQUENCES: usize = 1500;
+/// FMI 3.0 sequences per run (times `WHEELFLAT_FUZZ_SCALE`): about 15 s of CPU, 8 s
+/// more on this project's 2-core machine (an FMI 3.0 sequence costs what an FMI 2.0
+/// one does, 18 ms of CPU).
+const SEQUENCES3: usize = 700;
+/// The number of the first FMI 3.0 sequence (a sequence's number does not depend on the
+/// scale, so that `WHEELFLAT_FUZZ_SEQUENCE` replays it).
+const FMI3_BASE: usize = 1_000_000;
+/// The share of FMI 3.0 instances in an FMI 3.0 sequence (the others FMI 2.0).
+const FMI3_SHARE: f64 = 0.75;
 /// Random calls per sequence.
 const CALLS_PER_SEQUENCE: usize = 1000;
 /// Fuzzed instances alive at once, at most (plus the reference instance).
@@ -82,7 +114,8 @@ const SEED: u64 = 0x5EED_F1A7_2026;
 /// Communication step of the reference instance (s).
 const REF_H: f64 = 2e-5;
 
-/// Engine faults being fixed outside the C layer: inputs that trigger them.
+/// Faults being fixed outside this test (in the engine, the FMI layers, the C
+/// boundary): inputs that trigger them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Fault {
     /// fmi2DoStep with a subnormal step (0 < h < 1e-300) returns fmi2OK and NaN outputs.
@@ -105,19 +138,24 @@ enum Fault {
     ExtremeState,
 }
 
-/// The engine faults the generator avoids (unless `WHEELFLAT_FUZZ_KNOWN_FAULTS=1`), with
-/// what the fuzz test finds without the exclusion. Remove an entry when its fix is
-/// merged.
-const KNOWN_ENGINE_FAULTS: &[Fault] = &[];
+/// The faults the generator avoids (unless `WHEELFLAT_FUZZ_KNOWN_FAULTS=1`), with what
+/// the fuzz test finds without the exclusion. Remove an entry when its fix is merged.
+const KNOWN_FAULTS: &[Fault] = &[];
 
-/// `WHEELFLAT_FUZZ_TRACE=1`: every call printed before it is made.
-fn trace_calls() -> bool {
-    static ON: OnceLock<bool> = OnceLock::new();
-    *ON.get_or_init(|| std::env::var("WHEELFLAT_FUZZ_TRACE").is_ok_and(|v| v == "1"))
+/// `WHEELFLAT_FUZZ_TRACE=1`: every call printed before it is made (2: and the
+/// messages it logged after it).
+fn trace_calls() -> u8 {
+    static LEVEL: OnceLock<u8> = OnceLock::new();
+    *LEVEL.get_or_init(|| {
+        std::env::var("WHEELFLAT_FUZZ_TRACE")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0)
+    })
 }
 
 /// Whether the generator avoids the inputs of `f`: it is listed in
-/// [`KNOWN_ENGINE_FAULTS`] and not named in `WHEELFLAT_FUZZ_KNOWN_FAULTS` (`all`, or
+/// [`KNOWN_FAULTS`] and not named in `WHEELFLAT_FUZZ_KNOWN_FAULTS` (`all`, or
 /// names separated by commas: `SubnormalStep,TinySolverDt`).
 fn avoided(f: Fault) -> bool {
     static WANTED: OnceLock<String> = OnceLock::new();
@@ -125,28 +163,19 @@ fn avoided(f: Fault) -> bool {
         WANTED.get_or_init(|| std::env::var("WHEELFLAT_FUZZ_KNOWN_FAULTS").unwrap_or_default());
     let name = format!("{f:?}");
     let generated = wanted == "all" || wanted == "1" || wanted.split(',').any(|w| w.trim() == name);
-    !generated && KNOWN_ENGINE_FAULTS.contains(&f)
+    !generated && KNOWN_FAULTS.contains(&f)
 }
 
 // ------------------------------------------------------------------ driver
 
 fn run_sequence(seed: u64, sequence: usize, beat: Beat, stats: &Stats) {
-    let mut w = World {
-        rng: StdRng::seed_from_u64(seed ^ (sequence as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)),
-        seed,
-        sequence,
-        slots: Vec::new(),
-        freed_states: Vec::new(),
-        blobs: Vec::new(),
-        foreign: Box::new([0; 4]),
-        trace: VecDeque::new(),
-        beat,
-        calls: 0,
-        serial: 0,
-        valid: false,
+    let (version, k, share) = match sequence.checked_sub(FMI3_BASE) {
+        Some(k) => (Version::Fmi3, k, FMI3_SHARE),
+        None => (Version::Fmi2, sequence, 0.0),
     };
-    let kind = sequence % 3;
-    let mut reference = Reference::new(FMUS[kind]);
+    let mut w = World::new(seed, sequence, share, beat);
+    let kind = k % FMUS.len();
+    let mut reference = Reference::new(version, kind);
     // A few instances to start with.
     for _ in 0..w.rng.random_range(1..=3) {
         w.instantiate(true);
@@ -159,10 +188,10 @@ fn run_sequence(seed: u64, sequence: usize, beat: Beat, stats: &Stats) {
     if w.foreign.iter().any(|&x| x != 0) {
         w.fail("a foreign pointer's memory was written".into());
     }
-    let expected = &alone()[kind];
+    let expected = alone(version, kind);
     if let Some(k) = (0..expected.len()).find(|&k| reference.record[k] != expected[k]) {
         w.fail(format!(
-            "the reference {} instance differs from its run alone at step {k}",
+            "the reference {} instance ({version:?}) differs from its run alone at step {k}",
             FMUS[kind].model_identifier
         ));
     }
@@ -178,33 +207,55 @@ fn random_call_sequences_keep_the_fmi_contract() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0);
-    let only: Option<usize> = std::env::var("WHEELFLAT_FUZZ_SEQUENCE")
+    // `n` or `a..b`.
+    let only: Option<std::ops::Range<usize>> = std::env::var("WHEELFLAT_FUZZ_SEQUENCE")
         .ok()
-        .and_then(|s| s.parse().ok());
-    let n = ((SEQUENCES as f64 * scale).round() as usize).max(1);
-    let sequences: Vec<usize> = match only {
-        Some(s) => vec![s],
-        None => (0..n).collect(),
+        .and_then(|s| match s.split_once("..") {
+            Some((a, b)) => Some(a.parse().ok()?..b.parse().ok()?),
+            None => s.parse().ok().map(|n| n..n + 1),
+        });
+    let n_workers: usize = std::env::var("WHEELFLAT_FUZZ_WORKERS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or(WORKERS);
+    let part = std::env::var("WHEELFLAT_FUZZ_PART").unwrap_or_default();
+    let n = |base: usize, name: &str| match part.as_str() {
+        "" => ((base as f64 * scale).round() as usize).max(1),
+        p if p == name => ((base as f64 * scale).round() as usize).max(1),
+        _ => 0,
     };
-    let excluded: Vec<Fault> = KNOWN_ENGINE_FAULTS
+    let (n2, n3) = (n(SEQUENCES, "fmi2"), n(SEQUENCES3, "fmi3"));
+    let sequences: Vec<usize> = match only {
+        Some(r) => r.collect(),
+        None => {
+            // The two parts interleaved, in proportion.
+            let mut v: Vec<(f64, usize)> = (0..n2)
+                .map(|k| (k as f64 / n2 as f64, k))
+                .chain((0..n3).map(|k| ((k as f64 + 0.5) / n3 as f64, FMI3_BASE + k)))
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            v.into_iter().map(|x| x.1).collect()
+        }
+    };
+    let excluded: Vec<Fault> = KNOWN_FAULTS
         .iter()
         .copied()
         .filter(|&f| avoided(f))
         .collect();
     eprintln!(
-        "fmi_fuzz: seed {seed}, {} sequences of {CALLS_PER_SEQUENCE} calls, known engine \
-         faults avoided: {excluded:?}",
+        "fmi_fuzz: seed {seed}, {} sequences of {CALLS_PER_SEQUENCE} calls ({n2} FMI 2.0, {n3} \
+         FMI 3.0), known faults avoided: {excluded:?}",
         sequences.len()
     );
     let t0 = Instant::now();
-    alone();
     let stats = Arc::new(Stats::default());
     let next = Arc::new(AtomicUsize::new(0));
     let sequences = Arc::new(sequences);
     let failed = Arc::new(AtomicBool::new(false));
     let mut beats = Vec::new();
     let mut workers = Vec::new();
-    for _ in 0..WORKERS.min(sequences.len()) {
+    for _ in 0..n_workers.min(sequences.len()) {
         let beat: Beat = Arc::new(Mutex::new(None));
         beats.push(beat.clone());
         let (stats, next, sequences, failed) = (

@@ -1,5 +1,5 @@
-//! The instances of one sequence as the test follows them, and one random call on one
-//! of them.
+//! The instances of one sequence as the test follows them (FMI 2.0 and FMI 3.0 ones
+//! side by side), and one random call on one of them.
 
 use crate::args::boolean;
 use crate::calls::{Mirror, next_valid_call, pick_call};
@@ -8,19 +8,34 @@ use crate::stats::Stats;
 use crate::{MAX_INSTANCES, trace_calls};
 use rand::Rng;
 use rand::rngs::StdRng;
-use std::collections::VecDeque;
-use std::ffi::{CString, c_int};
+use std::collections::{HashMap, VecDeque};
+use std::ffi::{CString, c_int, c_void};
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use wheelflat::fmu::Call;
 use wheelflat::fmu::ffi::*;
-use wheelflat::fmu::vars::{FMUS, FmuTable, VarSpec, VarType};
+use wheelflat::fmu::ffi3::fmi3FreeInstance;
+use wheelflat::fmu::vars::{FMI3_FMUS, FMUS, Fmu3Table, FmuTable, VarSpec, VarType};
+
+/// The FMI version an instance was made with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Version {
+    Fmi2,
+    Fmi3,
+}
 
 pub struct Slot {
-    pub c: fmi2Component,
+    /// The `fmi2Component` or `fmi3Instance`.
+    pub c: *mut c_void,
+    pub version: Version,
     pub log: Box<Log>,
+    /// The instance has a logger (an FMI 3.0 instance may be made without one: nothing
+    /// can be checked of its messages).
+    pub logged: bool,
     pub table: &'static FmuTable,
+    /// The same FMU's FMI 3.0 table.
+    pub table3: &'static Fmu3Table,
     pub name: String,
     /// Communication time as far as the test knows.
     pub t: f64,
@@ -28,6 +43,20 @@ pub struct Slot {
     pub states: Vec<fmi2FMUstate>,
     /// The phase as far as the test knows.
     pub phase: Mirror,
+    /// FMI 3.0: the wheelsets in use (the size of every array) as far as the test knows;
+    /// `None` after an FMU state of unknown origin was set.
+    pub wheelsets: Option<usize>,
+    /// FMI 3.0: `earlyReturnAllowed` of the instantiation.
+    pub early_return: bool,
+}
+
+/// What the test knows of an FMI 3.0 FMU state: the phase, communication time and
+/// wheelsets of the instance when it was taken.
+#[derive(Debug, Clone, Copy)]
+pub struct Saved {
+    pub phase: Mirror,
+    pub t: f64,
+    pub wheelsets: Option<usize>,
 }
 
 /// What the watchdog sees of a worker: the call running and since when.
@@ -37,9 +66,15 @@ pub struct World {
     pub rng: StdRng,
     pub seed: u64,
     pub sequence: usize,
+    /// The share of FMI 3.0 instances among those the sequence starts with or makes
+    /// when it has none (0: FMI 2.0 only, drawing nothing from the generator).
+    pub fmi3_share: f64,
     pub slots: Vec<Slot>,
     pub freed_states: Vec<fmi2FMUstate>,
-    pub blobs: Vec<Vec<fmi2Byte>>,
+    /// FMI 3.0 states handed out, by address.
+    pub saved: HashMap<usize, Saved>,
+    /// Serialized states of either version (the same format).
+    pub blobs: Vec<Vec<u8>>,
     pub foreign: Box<[u64; 4]>,
     pub trace: VecDeque<String>,
     pub beat: Beat,
@@ -59,6 +94,29 @@ pub enum Status {
 }
 
 impl World {
+    /// A new world for sequence `sequence` of the run of base seed `seed`.
+    pub fn new(seed: u64, sequence: usize, fmi3_share: f64, beat: Beat) -> World {
+        use rand::SeedableRng;
+        World {
+            rng: StdRng::seed_from_u64(
+                seed ^ (sequence as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+            ),
+            seed,
+            sequence,
+            fmi3_share,
+            slots: Vec::new(),
+            freed_states: Vec::new(),
+            saved: HashMap::new(),
+            blobs: Vec::new(),
+            foreign: Box::new([0; 4]),
+            trace: VecDeque::new(),
+            beat,
+            calls: 0,
+            serial: 0,
+            valid: false,
+        }
+    }
+
     pub fn fail(&self, what: String) -> ! {
         let trace: Vec<&str> = self.trace.iter().map(|s| s.as_str()).collect();
         panic!(
@@ -72,8 +130,46 @@ impl World {
         )
     }
 
+    /// A new instance of either version ([`World::fmi3_share`]).
     pub fn instantiate(&mut self, valid: bool) -> Option<usize> {
-        let k = self.rng.random_range(0..3);
+        let p = self.fmi3_share;
+        let fmi3 = p >= 1.0 || (p > 0.0 && self.rng.random_bool(p));
+        if fmi3 {
+            self.instantiate3(valid)
+        } else {
+            self.instantiate2(valid)
+        }
+    }
+
+    /// A new slot for the instance `c` of FMU `kind` just made.
+    pub fn push_slot(
+        &mut self,
+        c: *mut c_void,
+        version: Version,
+        kind: usize,
+        log: Box<Log>,
+        name: String,
+    ) {
+        let (table, table3) = (FMUS[kind], FMI3_FMUS[kind]);
+        let wheelsets = Some(crate::fmi3_args::start_wheelsets(table3));
+        self.slots.push(Slot {
+            c,
+            version,
+            log,
+            logged: true,
+            table,
+            table3,
+            name,
+            t: 0.0,
+            states: Vec::new(),
+            phase: Mirror::Instantiated,
+            wheelsets,
+            early_return: false,
+        });
+    }
+
+    pub fn instantiate2(&mut self, valid: bool) -> Option<usize> {
+        let k = self.rng.random_range(0..FMUS.len());
         let table = FMUS[k];
         let log = Box::<Log>::default();
         let cb = callbacks(&log);
@@ -122,19 +218,17 @@ impl World {
         }
         if refused {
             if !no_functions {
-                self.check_messages(&log, 0, "fmi2Instantiate", Status::Error as c_int);
+                self.check_messages(
+                    &log,
+                    0,
+                    "fmi2Instantiate",
+                    Status::Error as c_int,
+                    Version::Fmi2,
+                );
             }
             return None;
         }
-        self.slots.push(Slot {
-            c,
-            log,
-            table,
-            name,
-            t: 0.0,
-            states: Vec::new(),
-            phase: Mirror::Instantiated,
-        });
+        self.push_slot(c, Version::Fmi2, k, log, name);
         Some(self.slots.len() - 1)
     }
 
@@ -152,7 +246,7 @@ impl World {
             short.truncate(k);
             short.push_str(" ...");
         }
-        if trace_calls() {
+        if trace_calls() > 0 {
             eprintln!("[{} {}] {short}", self.sequence, self.calls);
         }
         self.trace.push_back(short);
@@ -178,6 +272,7 @@ impl World {
         for s in &mut self.slots {
             s.states.retain(|&q| q != p);
         }
+        self.saved.remove(&(p as usize));
         self.freed_states.push(p);
     }
 
@@ -196,6 +291,14 @@ impl World {
         }
         let i = self.rng.random_range(0..self.slots.len());
         self.valid = self.rng.random_bool(0.5);
+        match self.slots[i].version {
+            Version::Fmi2 => self.one2(i, stats),
+            Version::Fmi3 => self.one3(i, stats),
+        }
+    }
+
+    /// One random FMI 2.0 call on instance `i`.
+    fn one2(&mut self, i: usize, stats: &Stats) {
         let call = if self.valid {
             next_valid_call(&mut self.rng, self.slots[i].phase)
         } else {
@@ -203,22 +306,14 @@ impl World {
         };
         if call == Call::Instantiate {
             if self.slots.len() < MAX_INSTANCES {
-                let made = self.instantiate(false).is_some();
+                let made = self.instantiate2(false).is_some();
                 stats.count(call, if made { 0 } else { 3 });
             }
             return;
         }
         if call == Call::FreeInstance {
             if self.slots.len() > 1 {
-                let s = self.slots.remove(i);
-                let from = s.log.len();
-                self.timed(format!("{}: fmi2FreeInstance()", s.name), || unsafe {
-                    fmi2FreeInstance(s.c)
-                });
-                self.check_messages(&s.log, from, "fmi2FreeInstance", 0);
-                for p in s.states {
-                    self.freed_states.push(p);
-                }
+                self.free_instance(i);
                 stats.count(call, 0);
             }
             return;
@@ -242,12 +337,37 @@ impl World {
         stats
             .slowest_us
             .fetch_max(d.as_micros() as usize, Ordering::Relaxed);
-        self.check_call(i, call, &desc, status, null_component, from);
+        self.check_call(i, call.name(), &desc, status, null_component, from);
     }
 
-    /// Prints every Real variable of every instance and stops (`WHEELFLAT_FUZZ_STOP_AT`).
+    /// Frees instance `i` (of either version) and forgets it.
+    pub fn free_instance(&mut self, i: usize) {
+        let s = self.slots.remove(i);
+        let from = s.log.len();
+        let name = match s.version {
+            Version::Fmi2 => "fmi2FreeInstance",
+            Version::Fmi3 => "fmi3FreeInstance",
+        };
+        self.timed(format!("{}: {name}()", s.name), || unsafe {
+            match s.version {
+                Version::Fmi2 => fmi2FreeInstance(s.c),
+                Version::Fmi3 => fmi3FreeInstance(s.c),
+            }
+        });
+        self.check_messages(&s.log, from, name, 0, s.version);
+        for p in s.states {
+            self.saved.remove(&(p as usize));
+            self.freed_states.push(p);
+        }
+    }
+
+    /// Prints the variables of every instance and stops (`WHEELFLAT_FUZZ_STOP_AT`).
     pub fn dump(&self) -> ! {
         for s in &self.slots {
+            if s.version == Version::Fmi3 {
+                crate::fmi3_dispatch::dump3(s);
+                continue;
+            }
             let vars: Vec<&VarSpec> = s
                 .table
                 .vars
@@ -270,7 +390,8 @@ impl World {
         self.fail(format!("stopped before call {}", self.calls));
     }
 
-    /// After a state was set: the communication time and phase from the instance.
+    /// After a state was set on FMI 2.0 instance `i`: the communication time and phase
+    /// from the instance.
     pub fn refresh_time(&mut self, i: usize) {
         let (mut t, mut ended) = (0.0, 0);
         let c = self.slots[i].c;
@@ -285,7 +406,7 @@ impl World {
         };
     }
 
-    /// Follows the phase of instance `i` after `call` returned `status`.
+    /// Follows the phase of FMI 2.0 instance `i` after `call` returned `status`.
     pub fn follow(&mut self, i: usize, call: Call, status: c_int) {
         let p = &mut self.slots[i].phase;
         *p = match (call, status) {
@@ -302,7 +423,10 @@ impl World {
 
     pub fn free_all(&mut self) {
         for s in self.slots.drain(..) {
-            unsafe { fmi2FreeInstance(s.c) };
+            match s.version {
+                Version::Fmi2 => unsafe { fmi2FreeInstance(s.c) },
+                Version::Fmi3 => unsafe { fmi3FreeInstance(s.c) },
+            }
         }
     }
 }

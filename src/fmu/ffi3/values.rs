@@ -63,6 +63,15 @@ fn absent(
         Call3::SetOther
     };
     with(instance, call, |i| {
+        // The state check and the refusals under the function's own name, not its
+        // family's.
+        i.check_as(call, name)?;
+        if vr.is_null() && nvr > 0 {
+            return i.refuse(
+                crate::fmu::Status::Error,
+                format!("{name}: argument `valueReferences` is a null pointer (count {nvr})"),
+            );
+        }
         let vr = slice(i, call, "valueReferences", vr, nvr)?;
         i.no_such_type(name, get, vr)
     })

@@ -42,6 +42,11 @@ pub fn translate(message: &str, running: Option<Call3>, table: &Fmu3Table) -> St
             m = m.replace(t.fmi2.guid, t.token);
         }
     }
+    // FMI 3.0 has no input derivatives: the advice to give them points to FMI 2.0.
+    m = m.replace(
+        "(fmi2SetRealInputDerivatives)",
+        "(input derivatives, which FMI 3.0 lacks: the FMI 2.0 unit takes them)",
+    );
     if m.contains("fmi2") {
         // Longest names first: fmi2GetRealOutputDerivatives before fmi2GetReal.
         let mut calls: Vec<_> = CALLS.iter().collect();
@@ -143,6 +148,15 @@ mod tests {
             ),
             "`x` (Parameter) cannot be set in state StepMode; y is not a Float64 input; \
              providesAdjointDerivatives is false"
+        );
+        assert_eq!(
+            translate(
+                "use at most 1e-4 s, give the wheel velocities (fmi2SetRealInputDerivatives), or",
+                Some(Call3::DoStep),
+                t
+            ),
+            "use at most 1e-4 s, give the wheel velocities (input derivatives, which FMI 3.0 \
+             lacks: the FMI 2.0 unit takes them), or"
         );
         assert_eq!(
             translate(&format!("the state of {}", t.fmi2.guid), None, t),
