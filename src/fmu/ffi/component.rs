@@ -115,16 +115,8 @@ impl Guarded for Instance {
     }
 }
 
-/// What an `fmi2Component` points to: the instance behind its busy flag.
-pub(super) type Component = guard::Component<Instance, CLogger>;
 /// The instance and the FMU states it handed out.
 pub(super) type Inner = guard::Inner<Instance>;
-
-/// Claims the instance behind `c` for `call`, or refuses (busy: logged).
-#[inline]
-pub(super) fn enter<'a>(c: fmi2Component, call: Call) -> Option<&'a Component> {
-    guard::enter::<Instance, CLogger>(c, call)
-}
 
 /// Runs `f` on the instance behind `c` after the state check of `call`, catching
 /// panics.

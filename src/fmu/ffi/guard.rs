@@ -238,6 +238,37 @@ impl<I: Guarded> Inner<I> {
     }
 }
 
+/// A new instance for the master: `inst` behind the busy flag `busy` (which its logger
+/// shares), with the master's logger `logger` and no FMU states yet.
+pub(crate) fn boxed<I, L>(busy: Arc<AtomicUsize>, logger: Option<L>, inst: I) -> *mut c_void {
+    let comp = Box::new(Component {
+        busy,
+        logger,
+        inner: UnsafeCell::new(Inner {
+            inst,
+            states: HashMap::new(),
+        }),
+    });
+    Box::into_raw(comp) as *mut c_void
+}
+
+/// Frees the instance behind `c` and every FMU state it handed out (`call`, the free
+/// function); refused (and logged) while another thread is in a call of it.
+pub(crate) fn free<I: Guarded, L: MasterLog>(c: *mut c_void, call: I::Call) {
+    if enter::<I, L>(c, call).is_none() {
+        return;
+    }
+    // The busy flag stays set: no call can start on the instance being freed.
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        let mut comp = unsafe { Box::from_raw(c as *mut Component<I, L>) };
+        let inner = comp.inner.get_mut();
+        let n = inner.states.len();
+        let m = format!("{}() ({n} FMU states freed with it)", I::call_name(call));
+        inner.inst.log_message(Status::Ok, "logCalls", &m);
+        drop(comp)
+    }));
+}
+
 /// Claims the instance behind `c` for `call`, or refuses (busy: logged).
 pub(crate) fn enter<'a, I: Guarded, L: MasterLog>(
     c: *mut c_void,

@@ -5,10 +5,9 @@
 
 use super::binary::{kind_for_guid, kind_of_binary, loaded_binary};
 use super::component::*;
+use super::guard;
 use super::types::*;
 use crate::fmu::{Call, Instance, Logger, Status};
-use std::cell::UnsafeCell;
-use std::collections::HashMap;
 use std::ffi::{CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -127,15 +126,8 @@ pub unsafe extern "C" fn fmi2Instantiate(
             }
             None => Box::new(|_, _, _| {}),
         };
-        let comp = Box::new(Component {
-            busy,
-            logger: clog,
-            inner: UnsafeCell::new(Inner {
-                inst: Instance::new(kind.table(), &name, logger, loggingOn == 1),
-                states: HashMap::new(),
-            }),
-        });
-        Box::into_raw(comp) as fmi2Component
+        let inst = Instance::new(kind.table(), &name, logger, loggingOn == 1);
+        guard::boxed(busy, clog, inst)
     }));
     r.unwrap_or(std::ptr::null_mut())
 }
@@ -144,19 +136,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// logged) while another thread is in a call of the instance.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    if enter(c, Call::FreeInstance).is_none() {
-        return;
-    }
-    // The busy flag stays set: no call can start on the instance being freed.
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        let mut comp = unsafe { Box::from_raw(c as *mut Component) };
-        let inner = comp.inner.get_mut();
-        let n = inner.states.len();
-        inner
-            .inst
-            .log_call(|| format!("fmi2FreeInstance() ({n} FMU states freed with it)"));
-        drop(comp)
-    }));
+    guard::free::<Instance, CLogger>(c, Call::FreeInstance)
 }
 
 /// `fmi2SetupExperiment`.

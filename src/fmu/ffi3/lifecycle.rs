@@ -3,11 +3,10 @@
 
 use super::component::*;
 use super::types::*;
+use crate::fmu::ffi::guard;
 use crate::fmu::ffi::{kind_of_binary, loaded_binary};
 use crate::fmu::fmi3::Call3;
 use crate::fmu::{Instance3, Kind, Logger, Status};
-use std::cell::UnsafeCell;
-use std::collections::HashMap;
 use std::ffi::c_char;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -157,19 +156,9 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
             }
             None => Box::new(|_, _, _| {}),
         };
-        let comp = Box::new(Component {
-            busy,
-            logger: clog,
-            inner: UnsafeCell::new(Inner {
-                inst: {
-                    let mut i = Instance3::new(kind.table3(), &name, logger, loggingOn);
-                    i.allow_early_return(earlyReturnAllowed);
-                    i
-                },
-                states: HashMap::new(),
-            }),
-        });
-        Box::into_raw(comp) as fmi3Instance
+        let mut inst = Instance3::new(kind.table3(), &name, logger, loggingOn);
+        inst.allow_early_return(earlyReturnAllowed);
+        guard::boxed(busy, clog, inst)
     }));
     r.unwrap_or(std::ptr::null_mut())
 }
@@ -177,19 +166,7 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
 /// `fmi3FreeInstance`: the instance and every FMU state it handed out.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
-    if enter(instance, Call3::FreeInstance).is_none() {
-        return;
-    }
-    // The busy flag stays set: no call can start on the instance being freed.
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        let mut comp = unsafe { Box::from_raw(instance as *mut Component) };
-        let inner = comp.inner.get_mut();
-        let n = inner.states.len();
-        inner
-            .inst
-            .log_call(|| format!("fmi3FreeInstance() ({n} FMU states freed with it)"));
-        drop(comp)
-    }));
+    guard::free::<Instance3, CLogger>(instance, Call3::FreeInstance)
 }
 
 /// `fmi3EnterConfigurationMode`.
