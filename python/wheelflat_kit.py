@@ -138,6 +138,27 @@ def _table(rows, names):
     return np.array([(t,) + tuple(v[n] for n in names) for t, v in rows], dtype=dtype)
 
 
+# fmpy (0.3.32) routes every FMI 2.0 logger through one native proxy that keeps the last
+# logger given to it: simulate_fmu(logger=...) points it at a callback that dies with the
+# call, and the next FMU that logs through fmpy's default callbacks (debug logging, a
+# warning) then calls freed memory and crashes the process. After such a run the proxy is
+# pointed back at fmpy's own printing logger, kept alive here.
+_DEFAULT_LOGGER = []
+
+
+def restore_fmpy_logger():
+    """Points fmpy's FMI 2.0 logger proxy back at fmpy's default logger (see above); call
+    after every simulate_fmu(logger=...) of an FMI 2.0 FMU."""
+    import ctypes
+    import fmpy.fmi2 as fmi2
+    from fmpy.logging import addLoggerProxy
+    if not _DEFAULT_LOGGER:
+        callbacks = fmi2.fmi2CallbackFunctions()
+        callbacks.logger = fmi2.fmi2CallbackLoggerTYPE(fmi2.printLogMessage)
+        _DEFAULT_LOGGER.append(callbacks)
+    addLoggerProxy(ctypes.byref(_DEFAULT_LOGGER[0]))
+
+
 class Log:
     """The FMU's log messages of a run, for fmpy.simulate_fmu(logger=...)."""
 
@@ -161,9 +182,12 @@ def simulate(path, model, stop, step, inp, outputs, start_values=None, start=STA
     import io
     from fmpy import simulate_fmu
     log = Log()
-    with contextlib.redirect_stdout(io.StringIO()):
-        r = simulate_fmu(path, start_time=start, stop_time=stop, output_interval=step, input=inp, output=outputs,
-                         start_values=start_values or {}, logger=log)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            r = simulate_fmu(path, start_time=start, stop_time=stop, output_interval=step, input=inp,
+                             output=outputs, start_values=start_values or {}, logger=log)
+    finally:
+        restore_fmpy_logger()
     return r, log.above_ok()
 
 

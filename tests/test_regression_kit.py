@@ -234,3 +234,25 @@ def test_a_kit_file_that_does_not_read_is_named(fmus, tmp_path):
     assert "RollPlaneVehicle_ref.csv does not read as a CSV table" in report["RollPlaneVehicle"][0], report
     assert "no Wagon_in.csv" in report["Wagon"][0], report
     assert "HalfCarBogie_ref.csv" in report["HalfCarBogie"][0], report
+
+
+def test_a_run_with_the_kits_logger_leaves_fmpys_default_logger_working(paths, tmp_path):
+    """fmpy's FMI 2.0 logger proxy keeps the last logger given to simulate_fmu: after the
+    kit's run (its own logger) the next FMU that logs through fmpy's default callbacks
+    called a dead callback and crashed the process (found when the fmusim test ran before
+    test_supports.py). In a fresh process, as a user's script would: the kit's run, then
+    a run with debug logging that logs every call."""
+    script = tmp_path / "two_runs.py"
+    script.write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {os.path.join(wf.ROOT, 'python')!r})\n"
+        "import gc\n"
+        "import wheelflat_kit as kit\n"
+        "from fmpy import simulate_fmu\n"
+        f"path = {paths['CoupledSystem']!r}\n"
+        "kit.simulate(path, 'CoupledSystem', 0.01, 1e-3, None, ['contact.left.force'], start=0.0)\n"
+        "gc.collect()\n"
+        "simulate_fmu(path, stop_time=0.01, debug_logging=True)\n"
+        "print('both runs done')\n")
+    p = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and "both runs done" in p.stdout, (p.returncode, p.stderr[-2000:])
