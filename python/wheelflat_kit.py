@@ -148,15 +148,17 @@ _DEFAULT_LOGGER = []
 
 def restore_fmpy_logger():
     """Points fmpy's FMI 2.0 logger proxy back at fmpy's default logger (see above); call
-    after every simulate_fmu(logger=...) of an FMI 2.0 FMU."""
+    after every simulate_fmu(logger=...) of an FMI 2.0 FMU. The proxy takes the logger of
+    a callbacks structure whose logger is not the proxy already (it puts itself there):
+    a fresh structure each time, its logger one callback kept alive here."""
     import ctypes
     import fmpy.fmi2 as fmi2
     from fmpy.logging import addLoggerProxy
     if not _DEFAULT_LOGGER:
-        callbacks = fmi2.fmi2CallbackFunctions()
-        callbacks.logger = fmi2.fmi2CallbackLoggerTYPE(fmi2.printLogMessage)
-        _DEFAULT_LOGGER.append(callbacks)
-    addLoggerProxy(ctypes.byref(_DEFAULT_LOGGER[0]))
+        _DEFAULT_LOGGER.append(fmi2.fmi2CallbackLoggerTYPE(fmi2.printLogMessage))
+    callbacks = fmi2.fmi2CallbackFunctions()
+    callbacks.logger = _DEFAULT_LOGGER[0]
+    addLoggerProxy(ctypes.byref(callbacks))
 
 
 class Log:
