@@ -11,8 +11,6 @@ use crate::fmu::{FmiResult, Instance3, Snapshot, Status};
 use std::ffi::{CString, c_int};
 use std::sync::atomic::AtomicUsize;
 
-pub(super) const ERROR: fmi3Status = Status::Error as c_int;
-
 /// The master's logger with its environment.
 #[derive(Clone)]
 pub(super) struct CLogger {
@@ -89,15 +87,8 @@ impl Guarded for Instance3 {
     }
 }
 
-/// What an `fmi3Instance` points to: the instance behind its busy flag.
-pub(super) type Component = guard::Component<Instance3, CLogger>;
 /// The instance and the FMU states it handed out.
 pub(super) type Inner = guard::Inner<Instance3>;
-
-/// Claims the instance behind `c` for `call`, or refuses (busy: logged).
-pub(super) fn enter<'a>(c: fmi3Instance, call: Call3) -> Option<&'a Component> {
-    guard::enter::<Instance3, CLogger>(c, call)
-}
 
 /// Runs `f` on the instance behind `c` as `call`, after its state check (the gets and
 /// sets of the absent types check under their own names), catching panics.

@@ -8,28 +8,15 @@
 
 use super::component::*;
 use super::types::*;
-use crate::fmu::Status;
-use crate::fmu::fmi3::{Allowed3, Call3};
+use crate::fmu::ffi::guard;
+use crate::fmu::fmi3::Call3;
+use crate::fmu::{Instance3, Status};
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::atomic::Ordering;
 
-/// Refuses the function `name` of the family `call` on the instance behind `instance`.
+/// Refuses the function `name` of the family `call` on the instance behind `instance`:
+/// the state table's refusal under the function's own name.
 fn unsupported(instance: fmi3Instance, call: Call3, name: &str) -> fmi3Status {
-    let Some(comp) = enter(instance, call) else {
-        return ERROR;
-    };
-    let inner = unsafe { &mut *comp.inner.get() };
-    let why = match call.allowed() {
-        Allowed3::Unsupported(why) => why,
-        _ => "",
-    };
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        let _ = inner
-            .inst
-            .refuse::<()>(Status::Error, format!("{name} is not supported: {why}"));
-    }));
-    comp.busy.store(0, Ordering::Release);
-    ERROR
+    guard::with_inner::<Instance3, CLogger>(instance, call, false, |x| x.inst.check_as(call, name))
 }
 
 /// `fmi3EnterEventMode`: not supported (refused with the reason).

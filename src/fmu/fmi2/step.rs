@@ -21,19 +21,19 @@ impl<M: Model> Instance<M> {
     /// status; one that stops it ([`StepFault::Stopped`]) gives `fmi2Error`, and the run
     /// can then only be reset or restored from an FMU state.
     pub fn do_step(&mut self, t: f64, h: f64) -> FmiResult {
-        self.step(t, h, false).map(|_| ())
+        self.step(t, h, false)
     }
 
     /// [`Instance::do_step`] that may end early, at an event of the model's own
     /// ([`Model::advance_to_event`]: a wheel coming into contact or losing it), for FMI
-    /// 3.0's early return: whether it did. The FMU's clock is then the model's time
-    /// there ([`Instance::last_successful_time`]), where the next step starts, and the
-    /// event is logged (`logEvents`).
-    pub fn do_step_to_event(&mut self, t: f64, h: f64) -> FmiResult<bool> {
+    /// 3.0's early return. Where it did, the FMU's clock is the model's time there
+    /// ([`Instance::last_successful_time`], before `t + h`), where the next step starts,
+    /// and the event is logged (`logEvents`).
+    pub fn do_step_to_event(&mut self, t: f64, h: f64) -> FmiResult {
         self.step(t, h, true)
     }
 
-    fn step(&mut self, t: f64, h: f64, early: bool) -> FmiResult<bool> {
+    fn step(&mut self, t: f64, h: f64, early: bool) -> FmiResult {
         self.check(Call::DoStep)?;
         if !(h.is_finite() && h > 0.0) {
             return self.refuse(
@@ -114,7 +114,6 @@ impl<M: Model> Instance<M> {
         if let Some((_, what)) = event.as_ref() {
             self.log_event(|| format!("returned early: {what}"));
         }
-        let early = event.is_some();
         self.time = end;
         // The step ended at stopTime (to the clock's rounding): a last step.
         let at_stop = self.stop_time.is_some_and(|s| (s - end).abs() <= clock);
@@ -134,7 +133,7 @@ impl<M: Model> Instance<M> {
             // report and returns fmi2OK, logging nothing (a warning at every step stopped
             // C fmusim, PyFMI and OMSimulator, and flooded the others' logs).
             if !self.step_warned.fresh(w.kind, w.severity) {
-                return Ok(early);
+                return Ok(());
             }
             let message = format!("fmi2DoStep: {}", w.message);
             self.warn(&message);
@@ -143,7 +142,7 @@ impl<M: Model> Instance<M> {
                 message,
             });
         }
-        Ok(early)
+        Ok(())
     }
 
     /// A failed step: the run ended (`fmi2Discard`, the `fmi2Terminated` status) or

@@ -379,8 +379,7 @@ impl<M: Model> Instance3<M> {
                     ),
                 );
             }
-            let k = if v.array { n.min(v.elements.len()) } else { 1 };
-            out.extend_from_slice(&v.elements[..k]);
+            out.extend_from_slice(&v.elements[..Self::in_use(v, n)]);
         }
         if out.len() != n_values {
             return self.refuse(
@@ -665,7 +664,7 @@ impl<M: Model> Instance3<M> {
     pub fn do_step(&mut self, t: f64, h: f64) -> (FmiResult, StepReport) {
         let r = self.check(Call3::DoStep).and_then(|()| {
             let r = match self.early_return {
-                true => self.inner.do_step_to_event(t, h).map(|_| ()),
+                true => self.inner.do_step_to_event(t, h),
                 false => self.inner.do_step(t, h),
             };
             fmi3(self.table, &self.running, r)
@@ -795,14 +794,16 @@ impl<M: Model> Instance3<M> {
         let n = self.wheelsets();
         let mut out = Vec::new();
         for (&r, &x) in vrs.iter().zip(per_variable) {
-            let k = match self.slot.get(r as usize).copied().flatten() {
-                Some(i) if self.table.vars[i as usize].array => {
-                    n.min(self.table.vars[i as usize].elements.len())
-                }
-                _ => 1,
-            };
+            let k = (self.slot.get(r as usize).copied().flatten())
+                .map_or(1, |i| Self::in_use(&self.table.vars[i as usize], n));
             out.extend(std::iter::repeat_n(x, k));
         }
         out
+    }
+
+    /// How many of the variable `v`'s values there are with `n` wheelsets: an array's
+    /// elements in use, one for a scalar.
+    fn in_use(v: &Var3Spec, n: usize) -> usize {
+        if v.array { n.min(v.elements.len()) } else { 1 }
     }
 }
