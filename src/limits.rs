@@ -45,6 +45,10 @@ const fn r(name: &'static str, min: f64, max: f64, unit: &'static str) -> Range 
 /// `MIN_WINDOW_SIDE` and the sleeper spacing when the simulation is built).
 const WINDOW_BEHIND: Range = r("track.window.behind", 4.0, 1000.0, "m");
 
+/// The longest contact patch the roughness may be averaged over (m): a wheel-rail
+/// patch is some 10 to 20 mm long.
+pub const MAX_PATCH_LENGTH: f64 = 0.05;
+
 /// Physical ranges of the parameters, by name (the FMUs' variable names).
 pub const PARAMETER_RANGES: &[Range] = &[
     r("speed", 0.0, 200.0, "m/s"),
@@ -82,6 +86,10 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("vehicle.bogie_distance", 2.0, 30.0, "m"),
     r("vehicle.carbody.pitch_inertia", 1e3, 1e8, "kg m^2"),
     r("vehicle.carbody.roll_inertia", 1e2, 1e7, "kg m^2"),
+    r("rail.spectrum.shortest_wavelength", 0.1, 1000.0, "m"),
+    r("rail.spectrum.longest_wavelength", 0.1, 1000.0, "m"),
+    r("rail.spectrum.ramp", 0.0, 1000.0, "m"),
+    r("roughness.patch_length", 0.0, MAX_PATCH_LENGTH, "m"),
     r("gravity", 0.0, 100.0, "m/s^2"),
     r("static_load.left", 0.0, 2e6, "N"),
     r("static_load.right", 0.0, 2e6, "N"),

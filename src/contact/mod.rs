@@ -18,6 +18,7 @@ mod calibration;
 mod hertz;
 mod law;
 mod perfect;
+mod roughness;
 mod state;
 #[cfg(test)]
 mod tests;
@@ -26,4 +27,7 @@ pub use adaptive::adaptive_numeric;
 pub use calibration::kw_from_hertz;
 pub use law::{ContactLaw, ContactModel};
 pub use perfect::{patch_angle, perfect_wheel_force};
+pub use roughness::{
+    ISO_3095_LIMIT, ISO_3095_NAME, RoughnessSpectrum, band_rms, contact_filter, hertz_half_length,
+};
 pub use state::ContactState;

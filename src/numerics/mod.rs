@@ -2,13 +2,15 @@
 //! the small-angle functions the wheel profile and the contact evaluate, root finding,
 //! Gauss-Legendre quadrature, the banded solver of the static start, the central
 //! differences of the vehicles' bodies and the amplitude of a harmonic in a signal (for
-//! measuring the quiet force's spectrum).
+//! measuring the quiet force's spectrum), and a random signal of given spectrum as a
+//! sum of cosines (rail profiles, roughness).
 
 mod banded;
 mod central_difference;
 mod harmonic;
 mod modes;
 mod quadrature;
+mod random_series;
 mod roots;
 mod simd;
 mod small_angle;
@@ -19,6 +21,7 @@ pub(crate) use central_difference::{CentralDifference, check_critical_step, mat_
 pub use harmonic::harmonic_amplitude;
 pub use modes::natural_frequencies;
 pub(crate) use quadrature::gauss_legendre;
+pub use random_series::{CosineSeries, Stream};
 pub(crate) use roots::{refine_root, sliver};
 pub use simd::{LANES, SimdLevel, inlined};
 pub use small_angle::*;

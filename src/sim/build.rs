@@ -10,11 +10,16 @@ use super::sites::sites;
 use super::static_start::{contact_law, static_loads};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
-use crate::contact::ContactLaw;
+use crate::contact::{ContactLaw, hertz_half_length};
+use crate::numerics::CosineSeries;
+use crate::sim::Roughness;
 use crate::error::{Error, Result, finite, num, out_of_range, positive};
 use crate::limits::{MAX_RAIL_SEGMENTS, MIN_DT_FRACTION, force_limit};
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
-use crate::track::{PointLoad, RailEnds, RailProfile, SimdLevel, Track, TrackParams};
+use crate::track::{
+    PointLoad, RailEnds, RailProfile, RandomProfile, SimdLevel, Track, TrackParams,
+};
+use std::sync::Arc;
 use crate::vehicle::{LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
 
@@ -293,8 +298,10 @@ impl Simulation {
                 VehicleSpec::Carrier(_) => VehicleState::OnBogie { axle },
             })
         };
+        let (rails, roughness) = random_irregularities(s, static_load);
         let lead = Wheelset::new(s.wheel_radius, &s.flats, 0.0, vehicle(0)?, "")?
-            .with_roundness(s.roundness.clone());
+            .with_roundness(s.roundness.clone())
+            .with_roughness(roughness(0));
         let trailing = s
             .trailing
             .iter()
@@ -303,7 +310,8 @@ impl Simulation {
                 let name = format!("wheelset[{k}].");
                 Ok(
                     Wheelset::new(s.wheel_radius, &w.flats, w.offset, vehicle(k - 1)?, &name)?
-                        .with_roundness(w.roundness.clone()),
+                        .with_roundness(w.roundness.clone())
+                        .with_roughness(roughness(k - 1)),
                 )
             })
             .collect::<Result<Vec<_>>>()?;
@@ -355,6 +363,8 @@ impl Simulation {
         };
         let mut scenario = s.clone();
         scenario.track = track_spec;
+        let irregular = rails.iter().any(RailProfile::is_some)
+            || wheelsets.iter().any(Wheelset::is_out_of_round);
         let mut sim = Simulation {
             scenario,
             track,
@@ -379,12 +389,8 @@ impl Simulation {
             carrier,
             shared_side_frames,
             voids: s.voids,
-            irregular: s.rails.iter().any(RailProfile::is_some)
-                || s.roundness
-                    .iter()
-                    .chain(s.trailing.iter().flat_map(|w| &w.roundness))
-                    .any(Option::is_some),
-            rails: s.rails.clone(),
+            irregular,
+            rails,
         };
         if let (Some(v), None, TrackState::Discrete(t)) = (&sim.voids, &sim.window, &sim.track) {
             // On a fixed track every hanging sleeper must be one of its sleepers.
@@ -467,4 +473,48 @@ fn carrier_on(s: &Scenario, dt: f64) -> Result<Option<Box<dyn RailVehicle>>> {
         }
     }
     c.whole(dt).map(Some)
+}
+
+/// The rails' profiles with what `s.random` draws on them, and a function giving
+/// wheelset `k`'s (0 the leading one) drawn wheel roughness `[left, right]`; the patch
+/// the roughness is seen through is `s.random`'s, or the Hertz patch under the static
+/// wheel load `static_load` `[left, right]` (N).
+#[allow(clippy::type_complexity)]
+fn random_irregularities(
+    s: &Scenario,
+    static_load: [f64; 2],
+) -> (
+    [RailProfile; 2],
+    impl Fn(usize) -> [Option<Arc<CosineSeries>>; 2] + '_,
+) {
+    let r = &s.random;
+    let half = move |side: usize, patch: f64| {
+        if patch > 0.0 {
+            0.5 * patch
+        } else {
+            hertz_half_length(s.wheel_radius, static_load[side], s.hertz_coefficient)
+        }
+    };
+    let mut rails = s.rails.clone();
+    let profile = r.profile.map(|p| p.series());
+    for (side, rail) in rails.iter_mut().enumerate() {
+        let mut series = profile.as_ref().map(|p| p[side].clone()).unwrap_or_default();
+        if let Some(Roughness { rail: Some(sp), seed, patch_length, .. }) = &r.roughness {
+            series = series.joined(&sp.rail(*seed, side, half(side, *patch_length)));
+        }
+        if !series.is_empty() {
+            rail.random = Some(Arc::new(RandomProfile {
+                series,
+                start: s.start_position,
+                ramp: r.profile.map_or(0.0, |p| p.ramp),
+            }));
+        }
+    }
+    let wheels = move |k: usize| match &r.roughness {
+        Some(Roughness { wheel: Some(sp), seed, patch_length, .. }) => [0, 1].map(|side| {
+            Some(Arc::new(sp.wheel(*seed, k, side, s.wheel_radius, half(side, *patch_length))))
+        }),
+        _ => [None, None],
+    };
+    (rails, wheels)
 }

@@ -6,7 +6,7 @@
 
 use super::Scenario;
 use crate::error::{Error, Result, finite, non_negative, num, out_of_range, positive};
-use crate::limits::MAX_WHEELSETS;
+use crate::limits::{MAX_PATCH_LENGTH, MAX_WHEELSETS};
 use crate::track::{FOLLOWABLE, FOLLOWABLE_SOURCE, RailProfile};
 
 /// Largest start position (m) by magnitude: a double resolves 1e-9 m there, well
@@ -98,6 +98,26 @@ impl Scenario {
         for (side, rail) in ["left", "right"].iter().zip(&s.rails) {
             if let Some(t) = &rail.measured {
                 RailProfile::check_measured(t, &format!("rail.{side}.profile"))?;
+            }
+        }
+        if let Some(p) = &s.random.profile {
+            p.validate()?;
+        }
+        if let Some(r) = &s.random.roughness {
+            for (name, sp) in [("roughness.rail", &r.rail), ("roughness.wheel", &r.wheel)] {
+                if let Some(sp) = sp {
+                    sp.validate(name)?;
+                }
+            }
+            if !(0.0..=MAX_PATCH_LENGTH).contains(&r.patch_length) {
+                return Err(out_of_range(
+                    "roughness.patch_length",
+                    r.patch_length,
+                    format!(
+                        "0 m (the Hertz patch under the static wheel load) <= patch length \
+                         <= {MAX_PATCH_LENGTH} m"
+                    ),
+                ));
             }
         }
         let wheels = std::iter::once(("wheel".to_string(), &s.roundness)).chain(

@@ -32,8 +32,8 @@ pub use build::{CONTACT_STIFFNESS_MARGIN, default_dt};
 pub use clock::StepPlan;
 pub use inputs::InputRates;
 pub use scenario::{
-    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
-    TrailingWheelset, VehicleSpec, VoidedSleepers, kmh,
+    DEFAULT_DT_FRACTION, DEFAULT_NODES_PER_SPAN, RandomIrregularities, Roughness, Scenario,
+    SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers, kmh,
 };
 pub use simulation::{Simulation, TrackState};
 pub use sites::{SITE_QUANTITIES, Site, SiteValues};

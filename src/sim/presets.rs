@@ -76,6 +76,7 @@ impl Scenario {
             voids: None,
             rails: Default::default(),
             roundness: Default::default(),
+            random: Default::default(),
         }
     }
 
@@ -178,6 +179,7 @@ impl Scenario {
             voids: None,
             rails: Default::default(),
             roundness: Default::default(),
+            random: Default::default(),
         }
     }
 
@@ -276,6 +278,7 @@ impl Scenario {
             voids: None,
             rails: Default::default(),
             roundness: Default::default(),
+            random: Default::default(),
         }
     }
 

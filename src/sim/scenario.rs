@@ -3,8 +3,8 @@
 //! track's window, hanging sleepers and the side frames at the axle boxes. The thesis'
 //! parameter sets as ready-made scenarios are in `presets.rs`.
 
-use crate::contact::ContactModel;
-use crate::track::RailProfile;
+use crate::contact::{ContactModel, RoughnessSpectrum};
+use crate::track::{ProfileSpec, RailProfile};
 use crate::track::{RailBetweenNodes, Supports, TrackParams};
 use crate::vehicle::{
     CarrierSpec, LumpedTrackParams, LumpedWheelParams, RollPlaneParams, SideFrameInertia,
@@ -132,6 +132,36 @@ pub struct Scenario {
     /// The leading wheelset's measured out-of-roundness `[left, right]`; `None`: round
     /// but for the flats.
     pub roundness: [Option<Arc<OutOfRoundness>>; 2],
+    /// The rails' profile drawn from a standard spectrum and the rails' and wheels'
+    /// short-wave roughness, on top of the above; default: none.
+    pub random: RandomIrregularities,
+}
+
+/// Irregularities drawn at random from standard spectra, on top of the measured ones
+/// (`docs/MODEL.md`, "Random rail profiles and roughness"): the same fields draw the
+/// same rails and wheels, on any track and window.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RandomIrregularities {
+    /// Both rails' vertical profile from a track spectrum; its ramp, from the leading
+    /// wheelset's start position, also brings in the rails' roughness.
+    pub profile: Option<ProfileSpec>,
+    /// Short-wave roughness of the rails and the wheels.
+    pub roughness: Option<Roughness>,
+}
+
+/// Short-wave roughness of the rails and the wheels from one-third octave band spectra,
+/// seen through the contact patch ([`crate::contact::contact_filter`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Roughness {
+    /// Each rail's spectrum (the rails drawn independently); `None`: smooth rails.
+    pub rail: Option<Arc<RoughnessSpectrum>>,
+    /// Each wheel's spectrum (every wheel drawn independently); `None`: smooth wheels.
+    pub wheel: Option<Arc<RoughnessSpectrum>>,
+    /// The seed.
+    pub seed: u64,
+    /// The contact patch's length along the rail (m) the roughness is averaged over; 0:
+    /// the Hertz patch under the static wheel load ([`crate::contact::hertz_half_length`]).
+    pub patch_length: f64,
 }
 
 /// Sleepers in a row that hang from the rails with a gap above the ballast, which

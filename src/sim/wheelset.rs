@@ -7,6 +7,7 @@ use super::vehicle_state::VehicleState;
 use crate::contact::{ContactLaw, ContactState};
 use crate::error::{Result, non_negative};
 use crate::track::PointLoad;
+use crate::numerics::CosineSeries;
 use crate::wheel::OutOfRoundness;
 use crate::wheel::{FlatSpec, WheelProfile};
 use std::cell::Cell;
@@ -39,6 +40,9 @@ pub struct Wheelset {
     wheels: [WheelProfile; 2],
     /// The wheels' measured out-of-roundness (none: round but for the flats).
     roundness: [Option<Arc<OutOfRoundness>>; 2],
+    /// The wheels' drawn roughness, radius deviation (m) against wheel angle (rad),
+    /// through the contact filter (none: smooth).
+    roughness: [Option<Arc<CosineSeries>>; 2],
     offset: f64,
     pub(crate) vehicle: VehicleState,
     pub(crate) extremes: ForceExtremes,
@@ -74,6 +78,7 @@ impl Wheelset {
                 WheelProfile::new(radius, &flats[1], &format!("{name}flat.right"))?,
             ],
             roundness: [None, None],
+            roughness: [None, None],
             offset,
             vehicle,
             extremes: ForceExtremes::NONE,
@@ -89,12 +94,25 @@ impl Wheelset {
         self
     }
 
+    /// The wheelset with the wheels' drawn roughness `[left, right]` (radius deviation
+    /// (m) against wheel angle (rad), `crate::contact::RoughnessSpectrum::wheel`).
+    pub fn with_roughness(mut self, roughness: [Option<Arc<CosineSeries>>; 2]) -> Self {
+        self.roughness = roughness;
+        self
+    }
+
+    /// Whether a wheel has an out-of-roundness or a roughness.
+    pub fn is_out_of_round(&self) -> bool {
+        self.roundness.iter().any(Option::is_some) || self.roughness.iter().any(Option::is_some)
+    }
+
     /// The radius deviation (m) of wheel `i` (0 left, 1 right) where it touches the
-    /// rail at axle rotation `gamma` (rad): its out-of-roundness at wheel angle
-    /// `gamma`; 0 for a wheel without one.
+    /// rail at axle rotation `gamma` (rad): its out-of-roundness and its roughness at
+    /// wheel angle `gamma`; 0 for a wheel without either.
     #[inline(always)]
     pub fn radius_deviation(&self, i: usize, gamma: f64) -> f64 {
         self.roundness[i].as_ref().map_or(0.0, |r| r.at(gamma))
+            + self.roughness[i].as_ref().map_or(0.0, |r| r.at(gamma).0)
     }
 
     /// `d/d gamma` of [`Wheelset::radius_deviation`] (m/rad).
@@ -102,6 +120,7 @@ impl Wheelset {
         self.roundness[i]
             .as_ref()
             .map_or(0.0, |r| r.slope_at(gamma))
+            + self.roughness[i].as_ref().map_or(0.0, |r| r.at(gamma).1)
     }
 
     /// The wheels `[left, right]`.

@@ -87,7 +87,7 @@ impl RailDefect {
 
 /// One rail's vertical profile along the line: the height of its running surface above
 /// the ideal line (m, up), a measured table (position (m) against height (m), the end
-/// heights beyond its ends) plus a discrete defect. It enters the contact where the
+/// heights beyond its ends) plus a discrete defect plus a drawn random profile. It enters the contact where the
 /// wheel touches the rail, as a change of the overlap (a raised rail presses into the
 /// wheel); the track's dynamics are those of the ideal rail loaded there.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -96,6 +96,9 @@ pub struct RailProfile {
     pub measured: Option<std::sync::Arc<Table>>,
     /// A dipped weld or joint.
     pub defect: Option<RailDefect>,
+    /// A profile drawn from a standard spectrum, with the rail's short-wave roughness
+    /// ([`super::ProfileSpec`], `crate::contact::RoughnessSpectrum`).
+    pub random: Option<std::sync::Arc<super::RandomProfile>>,
 }
 
 impl RailProfile {
@@ -121,7 +124,7 @@ impl RailProfile {
 
     /// Whether the rail has any irregularity.
     pub fn is_some(&self) -> bool {
-        self.measured.is_some() || self.defect.is_some()
+        self.measured.is_some() || self.defect.is_some() || self.random.is_some()
     }
 
     /// The height (m, up) and its slope `dh/dx` at `x` (m, line coordinates).
@@ -131,6 +134,11 @@ impl RailProfile {
         if let Some(t) = &self.measured {
             h += t.at(x);
             s += t.slope_at(x);
+        }
+        if let Some(r) = &self.random {
+            let (dh, ds) = r.at(x);
+            h += dh;
+            s += ds;
         }
         (h, s)
     }

@@ -24,6 +24,7 @@ mod params;
 mod probe;
 #[cfg(test)]
 mod reference_tests;
+mod spectra;
 mod state;
 mod static_solve;
 mod stepper;
@@ -44,6 +45,9 @@ pub use irregularity::{
 pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
+pub use spectra::{
+    PROFILE_BAND, ProfileSpec, RandomProfile, TERMS_PER_THIRD_OCTAVE, TrackSpectrum,
+};
 pub use stepper::{PointLoad, Track};
 pub use supports::{MAX_VOID_GAP, SupportLaw, Supports};
 pub use transparent::{MAX_EXACT_MEMORY, MIN_EXACT_MEMORY};

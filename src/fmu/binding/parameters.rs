@@ -2,11 +2,12 @@
 //! per engine struct.
 
 use super::Kind;
-use crate::contact::ContactModel;
+use crate::contact::{ContactModel, ISO_3095_NAME, RoughnessSpectrum};
 use crate::error::Error;
 use crate::fmu::vars;
 use crate::fmu::vars::enums::{
-    contact_model, flat_shape, interface, rail_between_nodes, support_law,
+    contact_model, flat_shape, interface, rail_between_nodes, rails_correlation, support_law,
+    track_spectrum,
 };
 use crate::fmu::vars::{
     FLAT_VRS, OFFSET_VRS, SITE_POSITION_VRS, STATIC_WHEEL_Z_VRS, TRAILING, TRAILING_FLAT_VRS,
@@ -15,11 +16,12 @@ use crate::fmu::vars::{
 use crate::numerics::Table;
 use crate::sim::VehicleUnitParams;
 use crate::sim::{
-    Scenario, SideFrameSpec, TrackSpec, TrackWindow, TrailingWheelset, VehicleSpec, VoidedSleepers,
+    RandomIrregularities, Roughness, Scenario, SideFrameSpec, TrackSpec, TrackWindow,
+    TrailingWheelset, VehicleSpec, VoidedSleepers,
 };
 use crate::track::{
-    RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw, Supports,
-    TrackParams,
+    ProfileSpec, RailBetweenNodes, RailDefect, RailEnds, RailProfile, RailSection, SupportLaw,
+    Supports, TrackParams, TrackSpectrum,
 };
 use crate::vehicle::{AboveAxleBoxes, RollPlaneParams, VehicleKind, kind_of_item};
 use crate::wheel::{FlatShape, FlatSpec, OutOfRoundness};
@@ -249,9 +251,46 @@ pub fn scenario(kind: Kind, v: &[f64]) -> Scenario {
                 length: val(vr::RAIL_DEFECT_LENGTH),
                 depth: val(depth),
             }),
+            random: None,
         }),
         roundness: Default::default(),
+        random: RandomIrregularities {
+            profile: track_spectrum(val(vr::RAIL_SPECTRUM)).map(|spectrum| ProfileSpec {
+                spectrum,
+                seed: val(vr::RAIL_SPECTRUM_SEED) as u64,
+                band: (
+                    val(vr::RAIL_SPECTRUM_SHORTEST_WAVELENGTH),
+                    val(vr::RAIL_SPECTRUM_LONGEST_WAVELENGTH),
+                ),
+                cross_level: item(rails_correlation::Item::of, val(vr::RAIL_SPECTRUM_RAILS))
+                    == rails_correlation::Item::CrossLevel,
+                ramp: val(vr::RAIL_SPECTRUM_RAMP),
+            }),
+            // The spectra are String parameters: `with_tables` gives them.
+            roughness: Some(Roughness {
+                rail: None,
+                wheel: None,
+                seed: val(vr::ROUGHNESS_SEED) as u64,
+                patch_length: val(vr::ROUGHNESS_PATCH_LENGTH),
+            }),
+        },
     }
+}
+
+/// The spectrum `rail.spectrum`'s value names; `None` for `none`.
+fn track_spectrum(value: f64) -> Option<TrackSpectrum> {
+    use track_spectrum::Item;
+    Some(match item(Item::of, value) {
+        Item::None => return None,
+        Item::FraClass1 => TrackSpectrum::Fra(1),
+        Item::FraClass2 => TrackSpectrum::Fra(2),
+        Item::FraClass3 => TrackSpectrum::Fra(3),
+        Item::FraClass4 => TrackSpectrum::Fra(4),
+        Item::FraClass5 => TrackSpectrum::Fra(5),
+        Item::FraClass6 => TrackSpectrum::Fra(6),
+        Item::OreLow => TrackSpectrum::OreLow,
+        Item::OreHigh => TrackSpectrum::OreHigh,
+    })
 }
 
 /// The largest table file read (bytes): a million points of two numbers in full
@@ -267,7 +306,11 @@ pub const MAX_TABLE_FILE: u64 = 100_000_000;
 /// `name` and the path; nothing of the file is quoted.
 pub fn table_content(name: &str, text: &str) -> Result<Arc<str>, Error> {
     let text = text.trim();
-    if text.is_empty() || text.contains(';') || text.contains('\n') {
+    if text.is_empty()
+        || text.contains(';')
+        || text.contains('\n')
+        || (name.starts_with("roughness.") && text == ISO_3095_NAME)
+    {
         return Ok(Arc::from(text));
     }
     let refuse = |why: String| {
@@ -327,6 +370,12 @@ pub fn check_table(name: &str, text: &str) -> Result<Arc<str>, Error> {
     } else {
         format!("{name} (the file {})", text.trim())
     };
+    if name.starts_with("roughness.") {
+        if !content.trim().is_empty() {
+            RoughnessSpectrum::parse(&content, &label)?;
+        }
+        return Ok(content);
+    }
     match parse_table(&label, &content)? {
         None => {}
         Some(t) if name.ends_with(".out_of_roundness") => {
@@ -358,6 +407,20 @@ pub fn with_tables(mut s: Scenario, contents: &[Arc<str>]) -> Result<Scenario, E
         // Checked by `Scenario::validate`, which `Simulation::new` calls first.
         if let Some(t) = parse_table(&name, text(&name))? {
             rail.measured = Some(Arc::new(t));
+        }
+    }
+    if let Some(r) = &mut s.random.roughness {
+        let spectrum = |name: &str| -> Result<Option<Arc<RoughnessSpectrum>>, Error> {
+            let t = text(name);
+            if t.trim().is_empty() {
+                return Ok(None);
+            }
+            Ok(Some(Arc::new(RoughnessSpectrum::parse(t, name)?)))
+        };
+        r.rail = spectrum("roughness.rail")?;
+        r.wheel = spectrum("roughness.wheel")?;
+        if r.rail.is_none() && r.wheel.is_none() {
+            s.random.roughness = None;
         }
     }
     for (i, side) in ["left", "right"].iter().enumerate() {
