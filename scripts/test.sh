@@ -63,7 +63,7 @@ bash scripts/build_fmusim.sh
 # command and test_docs.py's guide scripts pack fmu/ again, which the others read (two
 # pytest-xdist workers took 2.5 min off, but one of five runs lost a study command to an
 # abort at its exit, to be found).
-.venv/bin/python -m pytest -q tests/test_fmu_build.py tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_unload.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_fmi3.py tests/test_study_runs.py tests/test_study_cases.py tests/test_masters.py tests/test_fmi3_masters.py tests/test_importers.py tests/test_fmi3_fmusim.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_wagon.py tests/test_two_axle.py tests/test_numpy_track.py tests/test_figures.py tests/test_regression_kit.py tests/test_partner_bogie.py tests/test_partner_bogie3.py
+.venv/bin/python -m pytest -q tests/test_fmu_build.py tests/test_fmu_descriptions.py tests/test_fmu_states.py tests/test_fmu_unload.py tests/test_fmu_coupling.py tests/test_fmu_derivatives.py tests/test_fmi3.py tests/test_study_runs.py tests/test_study_cases.py tests/test_study_summary.py tests/test_masters.py tests/test_fmi3_masters.py tests/test_importers.py tests/test_fmi3_fmusim.py tests/test_docs.py tests/test_supports.py tests/test_accelerations.py tests/test_irregularities.py tests/test_random_track.py tests/test_spectra.py tests/test_wagon.py tests/test_two_axle.py tests/test_numpy_track.py tests/test_figures.py tests/test_regression_kit.py tests/test_partner_bogie.py tests/test_partner_bogie3.py tests/test_receptance.py
 fmi_rc=0
 wait "$fmi_build" || fmi_rc=$?
 cat "$fmi_log"

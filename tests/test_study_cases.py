@@ -297,10 +297,11 @@ def vehicle_items():
      "`speed` = '20' is text (in quotes), but `speed` takes a number"),
     ('name = "s"\nduration = 0.1\n[fixed]\nwheelsets = "two"\n',
      "`wheelsets` = 'two' is text (in quotes), but `wheelsets` takes a number: a whole number, 1 <= wheelsets <= 4"),
-    # Issue 38 (item 3): an enumeration's name was refused as "not a table: no file at".
-    ('name = "s"\nduration = 0.1\n[fixed]\n"vehicle.model" = "half_car"\n',
-     "`vehicle.model` = 'half_car' is text (in quotes), but `vehicle.model` takes a number: one of "
-     f"{vehicle_items()} (an enumeration: its number); for half_car write vehicle.model = 2"),
+    # Issue 38 (item 3): an enumeration's name was refused as "not a table: no file at";
+    # issue 44: an item's name is its number (test_study_summary.py), another text is refused.
+    ('name = "s"\nduration = 0.1\n[fixed]\n"vehicle.model" = "half_cart"\n',
+     "`vehicle.model` = 'half_cart' is not one of its items; allowed: one of "
+     f"{vehicle_items()} (an enumeration: its item's name, in quotes, or its number)"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = 20\n', "`rail.left.profile` = 20.0: a table"),
     ('name = "s"\nduration = 0.1\n[fixed]\n"rail.left.profile" = "0 0; 1 x"\n',
      "`rail.left.profile` (the table written out): line 1, its point 2 after a `;`: not two numbers (2 fields)"),

@@ -6,8 +6,9 @@ the outputs whose extremes to keep. Each case runs in the engine's study runner
 (``wheelflat_case``, the CoupledSystem model in process, sampled at every internal
 step), one persistent runner per Dask worker. Results go to ``results.parquet`` and
 ``results.csv`` (one row per case, with its parameters, the software version and the
-FMU GUID), ``impacts.parquet``/``.csv`` (one row per impact), and the plots the study
-asks for; a study started again skips the cases it already has.
+FMU GUID), ``impacts.parquet``/``.csv`` (one row per impact), ``summary.csv`` (the
+distribution of results over each case group of its ``[summary]``, summary.py) and the
+plots the study asks for; a study started again skips the cases it already has.
 
     wheelflat-study studies/speed_flat.toml [--scheduler ADDRESS] [--workers N]
 

@@ -194,8 +194,8 @@ def print_cases(study):
     def text(name, v):
         if hasattr(v, "sha256"):
             return f"{v.name if not inline(v.name) else 'table'} ({v.key})" if v.text else "no table"
-        factor = study.display.get(name, (None, 1.0))[1]
-        return f"{v * factor:g}"
+        # An enumeration by its item's name, a number in its display unit.
+        return study.shown(name, v)
 
     for case in study.iter_cases():
         print("\t".join([case.id] + [text(n, case.params[n]) for n in names]))
@@ -229,6 +229,13 @@ def check_variables(study, runner):
     for name in study.keep:
         if name not in outputs:
             raise ValueError(f"keep `{name}` is not a Real output of CoupledSystem (docs/VARIABLES.md)")
+    # An enumeration's item given by name is its number from here on (the same case, and
+    # case id, as the number); the items are kept for the case table, summary and plots.
+    for name in list(study.fixed) + list(study.sweep):
+        if name in known and known[name][0] == "Integer":
+            items = enumeration_items(name, known[name][1], known[name][2])
+            if items:
+                study.name_items(name, items)
     values = dict((k, [v]) for k, v in study.fixed.items())
     values.update(study.sweep)
     for name, vs in values.items():
@@ -262,17 +269,21 @@ def takes_a_number(name, v, ty, lo, hi):
     text = v.text if isinstance(v, Unread) else v.given or v.name
     items = enumeration_items(name, lo, hi) if ty == "Integer" else None
     if items:
-        allowed = "one of " + ", ".join(f"{k} = {item}" for k, item in items) + " (an enumeration: its number)"
+        allowed = ("one of " + ", ".join(f"{k} = {item}" for k, item in items)
+                   + " (an enumeration: its item's name, in quotes, or its number)")
     elif ty == "Integer":
         allowed = f"a whole number, {lo:g} <= {name} <= {hi:g}"
     else:
         allowed = f"{lo:g} <= {name} <= {hi:g}"
     said = f"`{name}` = {text!r} is text (in quotes), but `{name}` takes a number: {allowed}"
+    if items:
+        said = f"`{name}` = {text!r} is not one of its items; allowed: {allowed}"
     if _finite_text(text):
         said += f"; write it without quotes: {name} = {text.strip()}"
-    elif items and text.strip() in {item for _, item in items}:
-        k = dict((item, k) for k, item in items)[text.strip()]
-        said += f"; for {text.strip()} write {name} = {k}"
+    elif ty == "Integer" and not items and _descriptions() is not None and name not in _descriptions():
+        # The runner knows the variable, the FMUs beside it do not: another build's.
+        said += (f"; CoupledSystem.fmu beside the runner lacks `{name}` (another build's), so an enumeration's "
+                 f"items are unknown: pack the runner's build's FMUs (bash scripts/build_fmus_glibc228.sh fmu)")
     return said
 
 
@@ -283,24 +294,36 @@ def enumeration_items(name, lo, hi):
     when there is no such FMU or list, or the list does not cover lo to hi (another
     build than the runner's)."""
     import re
-    import zipfile
-    import xml.etree.ElementTree as ET
-    from . import fmu_paths
-    try:
-        with zipfile.ZipFile(fmu_paths()["CoupledSystem"]) as z:
-            root = ET.fromstring(z.read("modelDescription.xml"))
-    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError):
+    descriptions = _descriptions()
+    if descriptions is None or name not in descriptions:
         return None
-    for var in root.iter("ScalarVariable"):
-        if var.get("name") == name:
-            m = re.search(r"\(((?:[0-9]+ = [A-Za-z_][A-Za-z0-9_]*(?:, )?)+)\)\s*$", var.get("description") or "")
-            if not m:
-                return None
-            items = [(int(k), item) for k, item in re.findall(r"([0-9]+) = ([A-Za-z_][A-Za-z0-9_]*)", m.group(1))]
-            if [k for k, _ in items] != list(range(int(lo), int(hi) + 1)):
-                return None
-            return items
-    return None
+    m = re.search(r"\(((?:[0-9]+ = [A-Za-z_][A-Za-z0-9_]*(?:, )?)+)\)\s*$", descriptions[name])
+    if not m:
+        return None
+    items = [(int(k), item) for k, item in re.findall(r"([0-9]+) = ([A-Za-z_][A-Za-z0-9_]*)", m.group(1))]
+    if [k for k, _ in items] != list(range(int(lo), int(hi) + 1)):
+        return None
+    return items
+
+
+_DESCRIPTIONS = []
+
+
+def _descriptions():
+    """The description of every variable of this installation's CoupledSystem.fmu, by
+    name (read once); None when there is no such FMU."""
+    if not _DESCRIPTIONS:
+        import zipfile
+        import xml.etree.ElementTree as ET
+        from . import fmu_paths
+        try:
+            with zipfile.ZipFile(fmu_paths()["CoupledSystem"]) as z:
+                root = ET.fromstring(z.read("modelDescription.xml"))
+        except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError):
+            _DESCRIPTIONS.append(None)
+        else:
+            _DESCRIPTIONS.append({v.get("name"): v.get("description") or "" for v in root.iter("ScalarVariable")})
+    return _DESCRIPTIONS[0]
 
 
 if __name__ == "__main__":

@@ -379,14 +379,31 @@ def _run_locked(study, out_dir, scheduler, workers, serial, chunk, runner_path, 
     if total > have:
         log(_ran(counts, total - have, elapsed))
     from .tables import write_tables
-    table = write_tables(study, out_dir, ident, units=runner_units(runner_path or default_runner()))
+    units = runner_units(runner_path or default_runner())
+    table = write_tables(study, out_dir, ident, units=units)
     run_study.timing = {"startup_s": ready - started, "cases_s": finished - ready,
                         "tables_s": time.perf_counter() - finished}
     if plots and study.plots:
         from .plots import make_plots
         for p in make_plots(study, table, out_dir, log):
             log(f"wrote {p}")
+    if study.summary is not None:
+        from .summary import format_summary, write_summary
+        path, rows = write_summary(study, table, out_dir, units)
+        s = study.summary
+        log(f"summary over {', '.join(s.over)} ({percentile_words(s.percentile)} by numpy's linear "
+            f"interpolation, std with ddof = 1; count: the cases that finished with the result): {path}")
+        log(format_summary(study, rows, units))
     return table, counts["ok"] + counts["failed"]
+
+
+def percentile_words(q):
+    """`q` (0 to 100) as words: "the 95th percentile"."""
+    text = f"{q:g}"
+    last = text[-1]
+    suffix = "th" if text.endswith(("11", "12", "13")) or "." in text else {"1": "st", "2": "nd", "3": "rd"}.get(
+        last, "th")
+    return f"the {text}{suffix} percentile"
 
 
 def _ran(counts, count, elapsed):

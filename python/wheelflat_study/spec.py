@@ -16,11 +16,14 @@ from dataclasses import dataclass, field
 # The most cases one study may have.
 MAX_CASES = 1_000_000
 # The keys a study file may have, and those of a sweep entry.
-TOP_KEYS = {"name", "duration", "keep", "combine", "fixed", "sweep", "plot"}
+TOP_KEYS = {"name", "duration", "keep", "combine", "fixed", "sweep", "plot", "summary"}
 SWEEP_KEYS = {"values", "range", "random", "unit"}
 RANDOM_KEYS = {"low", "high", "n", "seed"}
 PLOT_KEYS = {"kind", "x", "y", "z", "by", "scale", "label", "title", "name"}
-PLOT_KINDS = {"lines": ("x", "y"), "heatmap": ("x", "y", "z"), "phase": ("x", "y", "z")}
+PLOT_KINDS = {"lines": ("x", "y"), "heatmap": ("x", "y", "z"), "phase": ("x", "y", "z"), "distribution": ("y",)}
+# The keys of a study's [summary], and the percentile it gives by default.
+SUMMARY_KEYS = {"over", "of", "percentile"}
+DEFAULT_PERCENTILE = 95.0
 
 # Units a study may give values in, to SI.
 UNITS = {None: 1.0, "": 1.0, "km/h": 1 / 3.6, "mm": 1e-3, "deg": math.pi / 180, "kN": 1e3,
@@ -134,6 +137,19 @@ class Case:
         return {k: v.sha256 for k, v in self.params.items() if isinstance(v, Table)}
 
 
+@dataclass(frozen=True)
+class Summary:
+    """A study's ``[summary]``: the cases that differ only in the swept variables
+    ``over`` (every other swept variable equal) form one case group, a distribution;
+    for each group and each result of ``of`` (a column of the results table, as a
+    plot's y names it) the summary gives the count, mean, sample standard deviation
+    (ddof = 1), the ``percentile`` (0 to 100, numpy's default linear interpolation),
+    min and max (summary.py)."""
+    over: tuple
+    of: tuple
+    percentile: float = DEFAULT_PERCENTILE
+
+
 @dataclass
 class Study:
     name: str
@@ -147,6 +163,12 @@ class Study:
     # The first `limit` cases only (the command's --limit; None: all): their ids are
     # the whole study's, so a run without it goes on with the rest.
     limit: int = None
+    # The [summary] (a Summary), or None.
+    summary: Summary = None
+    # The enumerations' items by variable: name -> {value: item}, for the variables the
+    # study sets whose items CoupledSystem's model description lists (the command's
+    # check_variables fills it; an item given by name is its number from there on).
+    items: dict = field(default_factory=dict)
 
     def __post_init__(self):
         # A study made in code, with a table's path or the table as text: read here,
@@ -155,6 +177,36 @@ class Study:
         self.fixed = {k: _tables(k, [v], base, cache)[0] if isinstance(v, str) else v for k, v in self.fixed.items()}
         self.sweep = {k: _tables(k, v, base, cache) if any(isinstance(x, str) for x in v) else v
                       for k, v in self.sweep.items()}
+
+    def name_items(self, name, items):
+        """Takes the enumeration `name`'s items [(value, item), ...]: keeps them for
+        the case table, the summary and the plots, and makes each value given by an
+        item's name (text, in quotes) that item's number (so `"hertz"` and `2` are the
+        same case, with the same id). Other text is left for the refusal."""
+        by_name = {item: float(k) for k, item in items}
+        self.items[name] = {float(k): item for k, item in items}
+
+        def number(v):
+            text = v.text if isinstance(v, Unread) else (v.given or v.name) if isinstance(v, Table) else v
+            return by_name.get(text.strip(), v) if isinstance(text, str) else v
+
+        if name in self.fixed:
+            self.fixed[name] = number(self.fixed[name])
+        if name in self.sweep:
+            self.sweep[name] = [number(v) for v in self.sweep[name]]
+
+    def shown(self, name, v):
+        """A variable's value as a person reads it: an enumeration's item by name, a
+        number in the study's display unit (``36``, for 10 m/s given in km/h), a table
+        by its name (its file's path, or the points written out; "no table")."""
+        if isinstance(v, (Table, Unread)):
+            v = v.name if isinstance(v, Table) else v.text
+        if isinstance(v, str):
+            return v or "no table"
+        items = self.items.get(name)
+        if items and float(v) in items:
+            return items[float(v)]
+        return f"{v * self.display.get(name, (None, 1.0))[1]:g}"
 
     def count(self):
         """The number of cases (at most :attr:`limit`)."""
@@ -524,8 +576,106 @@ def load_study(path):
         if "scale" in p and not (isinstance(p["scale"], (int, float)) and not isinstance(p["scale"], bool)
                                  and abs(p["scale"]) <= sys.float_info.max and p["scale"] != 0):
             raise ValueError(f"plot {i + 1}: scale = {p['scale']!r}: a finite number other than 0")
+    summary = _summary(d["summary"], fixed, sweep, keep) if "summary" in d else None
+    for i, p in enumerate(plots):
+        if p.get("kind") == "distribution":
+            _distribution(i, p, summary, fixed, sweep, keep)
     study = Study(name=name, duration=duration, fixed=fixed, sweep=sweep, combine=combine,
-                  keep=tuple(keep), plots=plots, display=display)
+                  keep=tuple(keep), plots=plots, display=display, summary=summary)
     if study.count() > MAX_CASES:
         raise ValueError(f"{study.count()} cases; at most {MAX_CASES} a study")
     return study
+
+
+def _results(fixed, sweep, keep):
+    """The results a [summary] or a distribution plot may name: the results table's
+    columns a case's answer gives (tables.result_columns), for the most wheelsets the
+    study sets."""
+    from .tables import result_columns
+    given = [fixed["wheelsets"]] if "wheelsets" in fixed else sweep.get("wheelsets", [1.0])
+    most = max((v for v in given if isinstance(v, (int, float))), default=1.0)
+    return result_columns(keep, int(min(max(most, 1.0), 4.0)))
+
+
+def _result(where, name, allowed, fixed, sweep):
+    """Refuses `name` at `where` unless it is one of the results `allowed`."""
+    if isinstance(name, str) and name in allowed:
+        return name
+    hint = ""
+    if isinstance(name, str):
+        m = re.fullmatch(r"peak\.wheelset\[([0-9]+)\]\.(left|right)", name)
+        if name in sweep or name in fixed:
+            hint = " (a parameter the study sets, not a result)"
+        elif m and 2 <= int(m.group(1)) <= 4:
+            hint = f" (set wheelsets = {m.group(1)} or more for it)"
+        elif name.endswith((".max", ".min")):
+            hint = f" (an output's extremes need it kept: keep = [\"{name[:-4]}\"])"
+    raise ValueError(f"{where} {name!r} is not a result of the study's cases{hint}; allowed: "
+                     f"{', '.join(allowed)}")
+
+
+def _summary(entry, fixed, sweep, keep):
+    """The study's [summary] (a :class:`Summary`), refused naming the key, the value
+    and what is allowed."""
+    if not isinstance(entry, dict):
+        raise ValueError(f"summary = {entry!r}: a table, [summary] with over, of and percentile")
+    extra = set(entry) - SUMMARY_KEYS
+    if extra:
+        raise ValueError(f"[summary]: unknown keys {sorted(extra)}; allowed: {sorted(SUMMARY_KEYS)}")
+    for key in ("over", "of"):
+        if key not in entry:
+            raise ValueError(f"[summary]: `{key}` is missing; it needs over (the swept variables whose cases form "
+                             f"one distribution) and of (the results summarised)")
+    swept = ", ".join(sweep) or "nothing (the study has no [sweep])"
+    over = entry["over"]
+    if not isinstance(over, list) or not over:
+        raise ValueError(f"[summary] over = {over!r}: a list of swept variables' names, such as over = "
+                         f"[\"{next(iter(sweep), 'rail.spectrum.seed')}\"]; swept: {swept}")
+    for name in over:
+        if not isinstance(name, str) or name not in sweep:
+            why = "is fixed, not swept" if isinstance(name, str) and name in fixed else "is not swept"
+            raise ValueError(f"[summary] over: {name!r} {why}; allowed: the swept variables ([sweep]): {swept}")
+    if len(set(over)) != len(over):
+        raise ValueError(f"[summary] over = {over!r}: a variable named twice")
+    of = entry["of"]
+    allowed = _results(fixed, sweep, keep)
+    if not isinstance(of, list) or not of:
+        raise ValueError(f"[summary] of = {of!r}: a list of results, such as of = [\"peak.left\"]; allowed: "
+                         f"{', '.join(allowed)}")
+    for name in of:
+        _result("[summary] of:", name, allowed, fixed, sweep)
+    if len(set(of)) != len(of):
+        raise ValueError(f"[summary] of = {of!r}: a result named twice")
+    q = entry.get("percentile", DEFAULT_PERCENTILE)
+    if isinstance(q, bool) or not isinstance(q, (int, float)) or not (math.isfinite(q) and 0 <= q <= 100):
+        raise ValueError(f"[summary] percentile = {q!r}: allowed a number from 0 to 100 (95: the 95th "
+                         f"percentile, numpy's linear interpolation)")
+    return Summary(over=tuple(over), of=tuple(of), percentile=float(q))
+
+
+def _distribution(i, p, summary, fixed, sweep, keep):
+    """Refuses a distribution plot the study cannot draw: one without a [summary], a
+    y that is not a result, a `by` that is not a swept variable outside the summary's
+    `over`, or one that leaves another swept variable to mix in a box."""
+    where = f"plot {i + 1} (distribution)"
+    if summary is None:
+        raise ValueError(f"{where}: needs a [summary] (its over: the swept variables whose cases make one box; its "
+                         f"percentile is marked)")
+    extra = set(p) & {"x", "z"}
+    if extra:
+        raise ValueError(f"{where}: {sorted(extra)} not allowed; a distribution plot has y (a result), by (the "
+                         f"swept variable of its boxes; optional), scale, label, title, name")
+    _result(f"{where}: y =", p["y"], _results(fixed, sweep, keep), fixed, sweep)
+    groups = [n for n in sweep if n not in summary.over]
+    if "by" in p:
+        by = p["by"]
+        if by not in groups:
+            why = ("is in the [summary]'s over (its values make one box)" if by in summary.over
+                   else "is not swept")
+            raise ValueError(f"{where}: by = {by!r} {why}; allowed: a swept variable outside the [summary]'s over: "
+                             f"{', '.join(groups) or 'none (every swept variable is in over: leave by out)'}")
+        other = [n for n in groups if n != by]
+        if other:
+            raise ValueError(f"{where}: by = {by!r}, but the swept {', '.join(other)} is neither by nor in the "
+                             f"[summary]'s over: each box would mix its values; leave by out (a box per case group) "
+                             f"or add it to over")

@@ -35,6 +35,26 @@ def _flatten(res):
     return row
 
 
+def result_columns(keep=(), wheelsets=1):
+    """The results table's columns that a case's answer gives (:func:`_flatten`'s, in
+    its order) for a study that keeps the outputs `keep` on at most `wheelsets`
+    wheelsets: what a [summary]'s `of` and a distribution plot's `y` may name
+    (tests/test_study_summary.py holds this list to a run's table)."""
+    cols = ["peak.left", "peak.right"]
+    for k in range(2, int(wheelsets) + 1):
+        cols += [f"peak.wheelset[{k}].left", f"peak.wheelset[{k}].right"]
+    cols.append("peak.max")
+    for wheel in ("left", "right"):
+        cols += [f"impacts.{wheel}", f"impact_peak.{wheel}", f"first_impact_peak.{wheel}",
+                 f"first_impact_span_position.{wheel}"]
+    for side in ("left", "right"):
+        cols += [f"bearing.{side}.max", f"bearing.{side}.min"]
+    cols += ["contact_loss.left", "contact_loss.right"]
+    for name in keep:
+        cols += [f"{name}.max", f"{name}.min"]
+    return cols
+
+
 # The unit of each column the case runner's result gives (src/bin/wheelflat_case.rs
 # documents its fields), by the column's name with the wheel or side left out; a
 # parameter's and a kept output's unit is the variable table's, as the runner lists it

@@ -138,10 +138,10 @@ pub struct ProfileSpec {
     /// The band's shortest and longest wavelengths (m).
     pub band: (f64, f64),
     /// `false`: each rail drawn from the vertical spectrum on its own; `true` (German
-    /// levels only): the mean of the rails from the vertical spectrum and their
+    /// levels only, `rail.spectrum.rails = cross_level`): the mean of the rails from the vertical spectrum and their
     /// difference from the cross-level spectrum.
     pub cross_level: bool,
-    /// Length (m) over which the profile grows from nothing (a raised cosine) from
+    /// Length (m) over which the profile grows from nothing (smoothly) from
     /// the leading wheelset's start position, so that the run starts at rest on
     /// ideal rails; 0: from the start, at full height.
     pub ramp: f64,
@@ -181,11 +181,12 @@ impl ProfileSpec {
         }
         if self.cross_level && self.spectrum.cross_level(1.0).is_none() {
             return Err(out_of_range(
-                "rail.spectrum.cross_level",
-                1.0,
+                "rail.spectrum.rails",
+                2.0,
                 format!(
-                    "false (the rails independent) with rail.spectrum = {}: only the German \
-                     levels (ore_low, ore_high) have the cross-level spectrum it draws",
+                    "1 (independent) with rail.spectrum = {}: only the German levels \
+                     (ore_low, ore_high) have the cross-level spectrum that 2 (cross_level) \
+                     draws",
                     self.spectrum.name()
                 ),
             ));
@@ -276,7 +277,9 @@ pub struct RandomProfile {
 
 impl RandomProfile {
     /// The height (m, up) and its slope at `x` (m): the terms times the ramp's factor
-    /// `(1 - cos(pi (x - start) / ramp)) / 2` over the ramp, 1 beyond, 0 before.
+    /// `q^3 (10 - 15 q + 6 q^2)`, `q = (x - start) / ramp`, over the ramp (its slope and
+    /// curvature 0 at both ends, so the wheel meets no jump of acceleration), 1 beyond,
+    /// 0 before.
     #[inline]
     pub fn at(&self, x: f64) -> (f64, f64) {
         let u = x - self.start;
@@ -287,13 +290,14 @@ impl RandomProfile {
         if u >= self.ramp {
             return (h, s);
         }
-        let (sin, cos) = (PI * u / self.ramp).sin_cos();
-        let (w, dw) = (0.5 * (1.0 - cos), 0.5 * PI / self.ramp * sin);
+        let q = u / self.ramp;
+        let w = q * q * q * (10.0 + q * (-15.0 + 6.0 * q));
+        let dw = 30.0 * q * q * (1.0 - q) * (1.0 - q) / self.ramp;
         (w * h, w * s + dw * h)
     }
 }
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 #[cfg(test)]
 mod tests {
@@ -384,7 +388,7 @@ mod tests {
             ..spec
         };
         let e = bad.validate().unwrap_err().to_string();
-        assert!(e.contains("rail.spectrum.cross_level") && e.contains("fra_class_4"), "{e}");
+        assert!(e.contains("rail.spectrum.rails") && e.contains("fra_class_4"), "{e}");
     }
 
     #[test]
