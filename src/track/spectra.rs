@@ -280,7 +280,7 @@ impl RandomProfile {
     /// `q^3 (10 - 15 q + 6 q^2)`, `q = (x - start) / ramp`, over the ramp (its slope and
     /// curvature 0 at both ends, so the wheel meets no jump of acceleration), 1 beyond,
     /// 0 before.
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, x: f64) -> (f64, f64) {
         let u = x - self.start;
         if u <= 0.0 {
