@@ -25,6 +25,8 @@ target/release/ (built first if missing):
    carrying the digest of its study's results table, so a plot from an older model is
    found.
 4. The regression kit in regression/ (python/wheelflat_kit.py).
+5. The track's receptance against the independent reference, docs/figures/receptance.png
+   (issue 44; it carries the digest of both curves, as the studies' plots do).
 
 The stated rounding: a figure is compared as printed, number by number; a number may
 differ from the committed one by one unit in its last printed digit (a rounding
@@ -569,6 +571,56 @@ def source_axle_box_masters():
     return {"axle_box_masters.table": "\n\n" + markdown_table(head, rows) + "\n\n"}
 
 
+RECEPTANCE_PNG = os.path.join(ROOT, "docs", "figures", "receptance.png")
+
+
+def source_receptance():
+    """Issue 44: the default track's point receptance (one rail) at mid-span and at a
+    sleeper from the runner (`wheelflat receptance`, 800 frequencies) against the
+    independent reference (python/receptance_reference.py), the resonances marked:
+    docs/figures/receptance.png (carrying the digest of both curves, as the studies'
+    plots do), and the resonances the guide quotes."""
+    import numpy as np
+    import receptance_reference as reference
+    import wheelflat_receptance as wr
+    panels, figures, text = [], {}, []
+    with tempfile.TemporaryDirectory() as tmp:
+        for at, words in (("midspan", "at mid-span"), ("sleeper", "at a sleeper")):
+            csv = os.path.join(tmp, f"{at}.csv")
+            wr.run(csv, "--at", at, "--points", 800)
+            f, a = wr.read_csv(csv)
+            ref = reference.receptance(f, at, "one")
+            text.append("\n".join(f"{x:.4e},{abs(y):.4e},{abs(z):.4e}" for x, y, z in zip(f, a, ref)))
+            panels.append((f"point receptance {words}, one rail; the FMUs' default track (n = 8)",
+                           [("model (wheelflat receptance)", f, a, "C0-"),
+                            ("reference (exact Timoshenko, frequency domain)", f, ref, "k--")]))
+            peaks, ref_peaks = wr.extrema(f, a), wr.extrema(f, ref)
+            marks = [x for x, _ in ref_peaks + wr.extrema(f, ref, "min")]
+            away = np.array([all(abs(fi / x - 1) > 0.15 for x in marks) for fi in f])
+            figures[f"receptance.{at}.worst"] = f"{100 * float(max(abs(abs(a[away]) / abs(ref[away]) - 1))):.1f} %"
+            for kind, lo, hi in (("full_track", 20, 150), ("rail_pads", 150, 600), ("pp", 700, 1500)):
+                m = [x for x, _ in peaks if lo < x < hi][0]
+                r = [x for x, _ in ref_peaks if lo < x < hi][0]
+                figures[f"receptance.{at}.{kind}"] = f"{m:.1f} Hz"
+                figures[f"receptance.{at}.{kind}.reference"] = f"{r:.1f} Hz"
+                figures[f"receptance.{at}.{kind}.error"] = f"{100 * (m / r - 1):+.2f} %"
+    d = hashlib.sha256("\n".join(text).encode()).hexdigest()[:16]
+    where = os.path.relpath(RECEPTANCE_PNG, ROOT)
+    if CHECKING:
+        from PIL import Image, UnidentifiedImageError
+        try:
+            have = Image.open(RECEPTANCE_PNG).text.get(DIGEST_KEY)
+        except (FileNotFoundError, UnidentifiedImageError, OSError) as e:
+            have = None
+            STALE.append(f"{where}: missing or no PNG ({e}): run python3 python/wheelflat_figures.py")
+        if have is not None and have != d:
+            STALE.append(f"{where}: drawn from other receptances (digest {have}, the current build's {d}): "
+                         "run python3 python/wheelflat_figures.py")
+    else:
+        wr.plot_panels(RECEPTANCE_PNG, panels, metadata={DIGEST_KEY: d})
+    return figures
+
+
 SOURCES = {
     "regression": source_regression,
     "quickstart": source_quickstart,
@@ -585,6 +637,7 @@ SOURCES = {
     "impact_position": study_source("impact_position", impact_position_tables),
     "flat_phase": study_source("flat_phase", flat_phase_tables),
     "primary_stiffness": study_source("primary_stiffness", primary_stiffness_tables),
+    "receptance": source_receptance,
 }
 CHECKING = False
 STALE = []

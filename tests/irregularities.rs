@@ -134,6 +134,7 @@ fn a_dipped_weld_as_a_ready_shape_and_as_a_table_agree_and_raise_the_force() {
     table.rails[0] = RailProfile {
         measured: Some(Arc::new(Table::new(x, h, "weld").unwrap())),
         defect: None,
+        random: None,
     };
     let (fs, load) = forces(&shape, 0.2);
     let (ft, _) = forces(&table, 0.2);

@@ -95,7 +95,10 @@ fn the_ramp_starts_the_run_at_rest_and_seeds_draw_their_own_rails() {
         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     assert!(differ > 0.01 * load, "{differ}");
     let (ls, rs) = (h1.iter().map(|h| h[0]), h1.iter().map(|h| h[1]));
-    assert!(ls.zip(rs).any(|(l, r)| l != r), "the rails are drawn independently");
+    assert!(
+        ls.zip(rs).any(|(l, r)| l != r),
+        "the rails are drawn independently"
+    );
 }
 
 #[test]

@@ -10,6 +10,11 @@
 //!
 //! The presets are the thesis' fixed tracks; `--window 10` runs the FMUs' default, the
 //! endless track with 10 m kept ahead and behind (`--window 20`: the converged window).
+//!
+//! `wheelflat receptance ...` and `wheelflat receptance-fit MEASURED.csv ...`: the
+//! track's receptance and a fit to a measured one (issue 44; `wheelflat/receptance.rs`).
+//! `wheelflat spectra` and `wheelflat profile --spectrum NAME ...`: the standard track
+//! spectra's RMS over a band and a drawn rail profile (issue 44; `wheelflat/profile.rs`).
 
 use std::io::{BufWriter, Write};
 use std::process::ExitCode;
@@ -19,6 +24,11 @@ use wheelflat::sim::{Scenario, Simulation, TrackWindow, kmh};
 use wheelflat::track::RailBetweenNodes;
 use wheelflat::wheel::{FlatShape, FlatSpec};
 
+#[path = "wheelflat/profile.rs"]
+mod profile;
+#[path = "wheelflat/receptance.rs"]
+mod receptance;
+
 const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--flat SIDE:LEN_MM:DEPTH_MM:ANGLE_DEG[:haversine|chord]]... [--no-flats] \
 [--contact adaptive|hertz] [--kw N/m/rad] [--ch N/m^1.5] [--n NODES_PER_SPAN] \
@@ -26,7 +36,10 @@ const USAGE: &str = "usage: wheelflat [--preset NAME] [--speed KMH] \
 [--spans N] [--window AHEAD[:BEHIND]] [--start M] [--site M]... [--duration S] [--every K] \
 [--output FILE.csv]
 presets (the thesis' fixed tracks): table4.4 table4.4-flat (default) table4.1 table5.1 \
-table5.2 chapter2; --window 10: the FMUs' default endless track";
+table5.2 chapter2; --window 10: the FMUs' default endless track
+subcommands: wheelflat receptance ..., wheelflat receptance-fit MEASURED.csv ... \
+(wheelflat receptance --help); wheelflat spectra ..., wheelflat profile ... \
+(wheelflat profile --help)";
 
 fn num(flag: &str, v: Option<String>) -> Result<f64, String> {
     let v = v.ok_or_else(|| format!("{flag} needs a value"))?;
@@ -75,6 +88,14 @@ fn parse_flat(v: &str) -> Result<(usize, FlatSpec), String> {
 }
 
 fn run() -> Result<(), String> {
+    let rest = || std::env::args().skip(2).collect();
+    match std::env::args().nth(1).as_deref() {
+        Some("spectra") => return profile::spectra(rest()),
+        Some("profile") => return profile::profile(rest()),
+        Some("receptance") => return receptance::receptance(rest()),
+        Some("receptance-fit") => return receptance::receptance_fit(rest()),
+        _ => {}
+    }
     let mut args = std::env::args().skip(1);
     let mut scenario = Scenario::table_4_4_flat();
     let mut flats: Vec<(usize, FlatSpec)> = Vec::new();

@@ -146,7 +146,10 @@ impl RoughnessSpectrum {
         };
         let per_metre = |k: f64| scale.map_or(k, |r| k / r);
         for &(l, db) in &self.bands {
-            let (k_lo, k_hi) = (TAU / (l * 2f64.powf(1.0 / 6.0)), TAU / (l * 2f64.powf(-1.0 / 6.0)));
+            let (k_lo, k_hi) = (
+                TAU / (l * 2f64.powf(1.0 / 6.0)),
+                TAU / (l * 2f64.powf(-1.0 / 6.0)),
+            );
             let r2 = band_rms(db).powi(2);
             let ln = (k_hi / k_lo).ln();
             s.add_band(
@@ -223,12 +226,16 @@ mod tests {
             .sqrt();
         assert!((iso.rms() - rms).abs() < 1e-15);
         assert!((iso.rms() - 11.74e-6).abs() < 0.01e-6, "{}", iso.rms());
-        let t = RoughnessSpectrum::parse("0.025 -5; 0.0315 -4; 0.04 -3", "roughness.wheel").unwrap();
+        let t =
+            RoughnessSpectrum::parse("0.025 -5; 0.0315 -4; 0.04 -3", "roughness.wheel").unwrap();
         assert_eq!(t.bands().len(), 3);
         let e = RoughnessSpectrum::parse("0.025 -5; 0.04 -3", "roughness.wheel")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("roughness.wheel") && e.contains("third of an octave"), "{e}");
+        assert!(
+            e.contains("roughness.wheel") && e.contains("third of an octave"),
+            "{e}"
+        );
         let e = RoughnessSpectrum::parse("0.025 -5; 0.0315 90", "roughness.rail")
             .unwrap_err()
             .to_string();

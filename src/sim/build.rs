@@ -11,17 +11,17 @@ use super::static_start::{contact_law, static_loads};
 use super::vehicle_state::VehicleState;
 use super::wheelset::{Wheelset, Wheelsets};
 use crate::contact::{ContactLaw, hertz_half_length};
-use crate::numerics::CosineSeries;
-use crate::sim::Roughness;
 use crate::error::{Error, Result, finite, num, out_of_range, positive};
 use crate::limits::{MAX_RAIL_SEGMENTS, MIN_DT_FRACTION, force_limit};
+use crate::numerics::CosineSeries;
+use crate::sim::Roughness;
 use crate::sim::{DEFAULT_DT_FRACTION, Scenario, TrackSpec, TrackWindow, VehicleSpec};
 use crate::track::{
     PointLoad, RailEnds, RailProfile, RandomProfile, SimdLevel, Track, TrackParams,
 };
-use std::sync::Arc;
 use crate::vehicle::{LumpedTrack, LumpedWheels, RailVehicle, RollPlaneVehicle};
 use crate::wheel::WheelProfile;
+use std::sync::Arc;
 
 /// The contact stiffness passed to the track's stability limit is this many times the
 /// perfect wheel's `dP / d delta` at the force limit: a flat in the patch raises it by at
@@ -498,8 +498,17 @@ fn random_irregularities(
     let mut rails = s.rails.clone();
     let profile = r.profile.map(|p| p.series());
     for (side, rail) in rails.iter_mut().enumerate() {
-        let mut series = profile.as_ref().map(|p| p[side].clone()).unwrap_or_default();
-        if let Some(Roughness { rail: Some(sp), seed, patch_length, .. }) = &r.roughness {
+        let mut series = profile
+            .as_ref()
+            .map(|p| p[side].clone())
+            .unwrap_or_default();
+        if let Some(Roughness {
+            rail: Some(sp),
+            seed,
+            patch_length,
+            ..
+        }) = &r.roughness
+        {
             series = series.joined(&sp.rail(*seed, side, half(side, *patch_length)));
         }
         if !series.is_empty() {
@@ -511,8 +520,19 @@ fn random_irregularities(
         }
     }
     let wheels = move |k: usize| match &r.roughness {
-        Some(Roughness { wheel: Some(sp), seed, patch_length, .. }) => [0, 1].map(|side| {
-            Some(Arc::new(sp.wheel(*seed, k, side, s.wheel_radius, half(side, *patch_length))))
+        Some(Roughness {
+            wheel: Some(sp),
+            seed,
+            patch_length,
+            ..
+        }) => [0, 1].map(|side| {
+            Some(Arc::new(sp.wheel(
+                *seed,
+                k,
+                side,
+                s.wheel_radius,
+                half(side, *patch_length),
+            )))
         }),
         _ => [None, None],
     };

@@ -22,6 +22,8 @@ mod kernels;
 mod observe;
 mod params;
 mod probe;
+mod receptance;
+mod receptance_fit;
 #[cfg(test)]
 mod reference_tests;
 mod spectra;
@@ -45,6 +47,13 @@ pub use irregularity::{
 pub use observe::{RailResponse, SupportResponse};
 pub use params::{RailBetweenNodes, RailEnds, RailSection, TrackParams};
 pub use probe::perturbation_growth;
+pub use receptance::{
+    LoadAt, LoadedRails, RECEPTANCE_FREQUENCY_RANGE, ReceptanceSetup, ResponseAt, log_frequencies,
+    track_receptance,
+};
+pub use receptance_fit::{
+    FitOptions, FitParameter, FittedValue, ReceptanceFit, fit_receptance, unit_noise,
+};
 pub use spectra::{
     PROFILE_BAND, ProfileSpec, RandomProfile, TERMS_PER_THIRD_OCTAVE, TrackSpectrum,
 };

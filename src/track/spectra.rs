@@ -105,7 +105,8 @@ impl TrackSpectrum {
                 let a = self.ore_a_v().unwrap_or(0.0);
                 let (c2, r2) = (ORE_OMEGA_C.powi(2), ORE_OMEGA_R.powi(2));
                 a * c2 / (c2 - r2)
-                    * ((w / ORE_OMEGA_R).atan() / ORE_OMEGA_R - (w / ORE_OMEGA_C).atan() / ORE_OMEGA_C)
+                    * ((w / ORE_OMEGA_R).atan() / ORE_OMEGA_R
+                        - (w / ORE_OMEGA_C).atan() / ORE_OMEGA_C)
             }
         };
         f(hi) - f(lo)
@@ -123,7 +124,9 @@ impl TrackSpectrum {
         let w2 = omega * omega;
         Some(
             4.0 * a * ORE_OMEGA_C.powi(2) * w2
-                / ((w2 + ORE_OMEGA_R.powi(2)) * (w2 + ORE_OMEGA_C.powi(2)) * (w2 + ORE_OMEGA_S.powi(2))),
+                / ((w2 + ORE_OMEGA_R.powi(2))
+                    * (w2 + ORE_OMEGA_C.powi(2))
+                    * (w2 + ORE_OMEGA_S.powi(2))),
         )
     }
 }
@@ -220,7 +223,9 @@ impl ProfileSpec {
     pub fn series(&self) -> [CosineSeries; 2] {
         let (lo, hi) = self.wavenumbers();
         let terms = TERMS_PER_THIRD_OCTAVE * ((3.0 * (hi / lo).log2()).ceil() as usize).max(1);
-        let draw = |stream: u64, density: &dyn Fn(f64) -> f64, closed: Option<&dyn Fn(f64, f64) -> f64>| {
+        let draw = |stream: u64,
+                    density: &dyn Fn(f64) -> f64,
+                    closed: Option<&dyn Fn(f64, f64) -> f64>| {
             let mut s = CosineSeries::new();
             let mut rng = Stream::new(self.seed, stream);
             let variance = |k0: f64, k1: f64| match closed {
@@ -258,7 +263,12 @@ fn integrate(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     (0..pieces)
         .map(|p| {
             let c = a + h * (p as f64 + 0.5);
-            x.iter().zip(&w).map(|(x, w)| w * f(c + 0.5 * h * x)).sum::<f64>() * 0.5 * h
+            x.iter()
+                .zip(&w)
+                .map(|(x, w)| w * f(c + 0.5 * h * x))
+                .sum::<f64>()
+                * 0.5
+                * h
         })
         .sum()
 }
@@ -358,7 +368,10 @@ mod tests {
         let [l, _] = spec.series();
         let n = 200_000;
         let ms = (0..n).map(|i| l.at(i as f64 * 0.1).0.powi(2)).sum::<f64>() / n as f64;
-        assert!((ms.sqrt() / spec.variance().sqrt() - 1.0).abs() < 0.02, "{ms}");
+        assert!(
+            (ms.sqrt() / spec.variance().sqrt() - 1.0).abs() < 0.02,
+            "{ms}"
+        );
     }
 
     #[test]
@@ -388,7 +401,10 @@ mod tests {
             ..spec
         };
         let e = bad.validate().unwrap_err().to_string();
-        assert!(e.contains("rail.spectrum.rails") && e.contains("fra_class_4"), "{e}");
+        assert!(
+            e.contains("rail.spectrum.rails") && e.contains("fra_class_4"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -428,9 +444,27 @@ mod tests {
         };
         assert!(ok.validate().is_ok());
         for (spec, name) in [
-            (ProfileSpec { band: (0.01, 30.0), ..ok }, "shortest_wavelength"),
-            (ProfileSpec { band: (1.5, 5000.0), ..ok }, "longest_wavelength"),
-            (ProfileSpec { band: (10.0, 5.0), ..ok }, "longest_wavelength"),
+            (
+                ProfileSpec {
+                    band: (0.01, 30.0),
+                    ..ok
+                },
+                "shortest_wavelength",
+            ),
+            (
+                ProfileSpec {
+                    band: (1.5, 5000.0),
+                    ..ok
+                },
+                "longest_wavelength",
+            ),
+            (
+                ProfileSpec {
+                    band: (10.0, 5.0),
+                    ..ok
+                },
+                "longest_wavelength",
+            ),
             (ProfileSpec { ramp: -1.0, ..ok }, "rail.spectrum.ramp"),
         ] {
             let e = spec.validate().unwrap_err().to_string();
