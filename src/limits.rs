@@ -88,7 +88,7 @@ pub const PARAMETER_RANGES: &[Range] = &[
     r("vehicle.carbody.roll_inertia", 1e2, 1e7, "kg m^2"),
     r("rail.spectrum.shortest_wavelength", 0.1, 1000.0, "m"),
     r("rail.spectrum.longest_wavelength", 0.1, 1000.0, "m"),
-    r("rail.spectrum.ramp", 0.0, 1000.0, "m"),
+    r("rail.spectrum.ramp", 1.0, 1000.0, "m"),
     r("roughness.patch_length", 0.0, MAX_PATCH_LENGTH, "m"),
     r("gravity", 0.0, 100.0, "m/s^2"),
     r("static_load.left", 0.0, 2e6, "N"),

@@ -30,6 +30,10 @@ UNITS = {None: 1.0, "": 1.0, "km/h": 1 / 3.6, "mm": 1e-3, "deg": math.pi / 180, 
          "MN/m": 1e6, "kN.s/m": 1e3}
 
 
+# The ready roughness spectrum a `roughness.*` String parameter names (the engine's
+# ISO_3095_NAME): passed on as it is, not read as a file.
+ISO_3095 = "iso3095"
+
 # A table's file: at most this many bytes (the engine's MAX_TABLE_FILE) and points
 # (its MAX_TABLE_POINTS).
 MAX_TABLE_FILE = 100_000_000
@@ -325,6 +329,9 @@ def read_table(name, v, base, cache=None):
     where = f"`{name}` = {v!r}"
     if not v.strip():
         return NO_TABLE
+    if name.startswith("roughness.") and v.strip() == ISO_3095:
+        # The ready spectrum by its name, as the engine takes it (no file is read).
+        return Table(ISO_3095, ISO_3095, hashlib.sha256(ISO_3095.encode()).hexdigest(), v)
     if inline(v):
         return _table(f"`{name}` (the table written out)", None, v)
     path = os.path.normpath(os.path.join(base, v.strip()))

@@ -109,6 +109,15 @@ impl Scenario {
                     sp.validate(name)?;
                 }
             }
+            if r.patch_length == 0.0 && s.hertz_coefficient <= 0.0 {
+                return Err(out_of_range(
+                    "contact.CH",
+                    s.hertz_coefficient,
+                    "contact.CH > 0 N/m^1.5 when roughness.patch_length = 0 (the roughness is \
+                     averaged over the Hertz patch under the static load, which needs it): give \
+                     contact.CH, or roughness.patch_length > 0 m",
+                ));
+            }
             if !(0.0..=MAX_PATCH_LENGTH).contains(&r.patch_length) {
                 return Err(out_of_range(
                     "roughness.patch_length",

@@ -208,8 +208,9 @@ impl Simulation {
             let i = self.irregularity(0);
             format!(
                 "the irregularities under the leading wheels (rail.*.profile, \
-                 wheel.*.out_of_roundness, rail.defect.*: the overlap shifted by {} m and {} \
-                 m now) may drive it, a rise too steep for this speed; else {step}",
+                 wheel.*.out_of_roundness, rail.defect.*, rail.spectrum.*, roughness.*: the \
+                 overlap shifted by {} m and {} m now) may drive it, a rise too steep for this \
+                 speed; else {step}",
                 num(i[0]),
                 num(i[1])
             )

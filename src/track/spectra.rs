@@ -22,6 +22,9 @@ const ORE_OMEGA_R: f64 = 0.0206;
 const ORE_OMEGA_S: f64 = 0.4380;
 const ORE_A_V: [f64; 2] = [4.032e-7, 1.080e-6];
 
+/// The shortest ramp (m) over which a drawn profile comes in.
+pub const MIN_RAMP: f64 = 1.0;
+
 /// Terms of the drawn profile in each one-third octave of wavenumber.
 pub const TERMS_PER_THIRD_OCTAVE: usize = 8;
 
@@ -146,7 +149,7 @@ pub struct ProfileSpec {
     pub cross_level: bool,
     /// Length (m) over which the profile grows from nothing (smoothly) from
     /// the leading wheelset's start position, so that the run starts at rest on
-    /// ideal rails; 0: from the start, at full height.
+    /// ideal rails; at least [`MIN_RAMP`].
     pub ramp: f64,
 }
 
@@ -194,11 +197,15 @@ impl ProfileSpec {
                 ),
             ));
         }
-        if !(0.0..=PROFILE_BAND.1).contains(&self.ramp) {
+        if !(MIN_RAMP..=PROFILE_BAND.1).contains(&self.ramp) {
             return Err(out_of_range(
                 "rail.spectrum.ramp",
                 self.ramp,
-                format!("0 m <= ramp <= {} m", PROFILE_BAND.1),
+                format!(
+                    "{MIN_RAMP} m <= ramp <= {} m (the wheels start on ideal rails: a profile \
+                     at full height at the start would jump under them at the first step)",
+                    PROFILE_BAND.1
+                ),
             ));
         }
         Ok(())

@@ -101,7 +101,7 @@ pub fn spectra(args: Vec<String>) -> Result<(), String> {
             seed: 0,
             band,
             cross_level: false,
-            ramp: 0.0,
+            ramp: 1.0,
         };
         spec.validate().map_err(|e| e.to_string())?;
         let (lo, hi) = spec.wavenumbers();
@@ -177,7 +177,7 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
         seed: seed as u64,
         band: band(&args)?,
         cross_level,
-        ramp: 0.0,
+        ramp: 1.0,
     };
     spec.validate().map_err(|e| e.to_string())?;
     let (length, dx) = (
