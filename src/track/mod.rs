@@ -55,7 +55,7 @@ pub use receptance_fit::{
     FitOptions, FitParameter, FittedValue, ReceptanceFit, fit_receptance, unit_noise,
 };
 pub use spectra::{
-    PROFILE_BAND, ProfileSpec, RandomProfile, TERMS_PER_THIRD_OCTAVE, TrackSpectrum,
+    MIN_RAMP, PROFILE_BAND, ProfileSpec, RandomProfile, TERMS_PER_THIRD_OCTAVE, TrackSpectrum,
 };
 pub use stepper::{PointLoad, Track};
 pub use supports::{MAX_VOID_GAP, SupportLaw, Supports};
