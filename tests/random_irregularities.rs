@@ -118,6 +118,15 @@ fn rail_roughness_reaches_the_contact_through_the_patch() {
         }),
     };
     let mut sim = Simulation::new(&s).unwrap();
+    // Without a drawn profile the roughness is there from the start, where the static
+    // start stands the wheels on it: the first step's force is the static load's, to
+    // the roughness's own change over one step's travel (0.3 mm).
+    let static_load = sim.static_load()[0];
+    let first = Simulation::new(&s).unwrap().step().unwrap().contact[0].force;
+    assert!(
+        (first - static_load).abs() < 0.01 * static_load,
+        "{first} {static_load}"
+    );
     let half = hertz_half_length(s.wheel_radius, sim.static_load()[0], s.hertz_coefficient);
     assert!((0.004..0.01).contains(&half), "{half}");
     let raw = iso.rail(3, 0, 0.0);

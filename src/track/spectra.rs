@@ -8,6 +8,7 @@
 //! of `S` over it.
 
 use super::*;
+use crate::error::num;
 use crate::numerics::{CosineSeries, Stream};
 
 /// FRA: `Omega_c` (rad/m) and the scale `k` of Hamid and Yang's form (below).
@@ -162,15 +163,25 @@ impl ProfileSpec {
     /// Checks the fields; errors name the parameter (`rail.spectrum.*`).
     pub fn validate(&self) -> Result<()> {
         let (lo, hi) = self.band;
-        for (name, v) in [
-            ("rail.spectrum.shortest_wavelength", lo),
-            ("rail.spectrum.longest_wavelength", hi),
+        // The shortest up to the longest's limit less a third of an octave (the
+        // table's 500 m), the longest from the shortest's plus one (0.2 m).
+        for (name, v, range) in [
+            (
+                "rail.spectrum.shortest_wavelength",
+                lo,
+                (PROFILE_BAND.0, 500.0),
+            ),
+            (
+                "rail.spectrum.longest_wavelength",
+                hi,
+                (0.2, PROFILE_BAND.1),
+            ),
         ] {
-            if !(PROFILE_BAND.0..=PROFILE_BAND.1).contains(&v) {
+            if !(range.0..=range.1).contains(&v) {
                 return Err(out_of_range(
                     name,
                     v,
-                    format!("{} m <= wavelength <= {} m", PROFILE_BAND.0, PROFILE_BAND.1),
+                    format!("{} m <= wavelength <= {} m", range.0, range.1),
                 ));
             }
         }
@@ -180,8 +191,9 @@ impl ProfileSpec {
                 hi,
                 format!(
                     "at least a third of an octave above rail.spectrum.shortest_wavelength \
-                     ({lo} m): >= {} m",
-                    1.26 * lo
+                     ({} m): >= {} m",
+                    num(lo),
+                    num((1.26e6 * lo).round() / 1e6)
                 ),
             ));
         }
@@ -288,17 +300,22 @@ pub struct RandomProfile {
     pub series: CosineSeries,
     /// Where the ramp begins (m): nothing before it.
     pub start: f64,
-    /// The ramp's length (m); 0: full height from `start` on.
+    /// The ramp's length (m); 0: no ramp, full height everywhere (the rails' roughness
+    /// without a drawn profile: the static start stands the wheels on it).
     pub ramp: f64,
 }
 
 impl RandomProfile {
-    /// The height (m, up) and its slope at `x` (m): the terms times the ramp's factor
+    /// The height (m, up) and its slope at `x` (m): with no ramp (0) the terms
+    /// everywhere; else the terms times the ramp's factor
     /// `q^3 (10 - 15 q + 6 q^2)`, `q = (x - start) / ramp`, over the ramp (its slope and
     /// curvature 0 at both ends, so the wheel meets no jump of acceleration), 1 beyond,
     /// 0 before.
     #[inline(always)]
     pub fn at(&self, x: f64) -> (f64, f64) {
+        if self.ramp <= 0.0 {
+            return self.series.at(x);
+        }
         let u = x - self.start;
         if u <= 0.0 {
             return (0.0, 0.0);

@@ -65,11 +65,22 @@ fn spectrum(name: &str) -> Result<TrackSpectrum, String> {
         })
 }
 
+/// Every argument a known flag followed by its value, each flag at most once.
 fn check_flags(args: &[String], allowed: &[&str]) -> Result<(), String> {
     let mut i = 0;
+    let mut seen = Vec::new();
     while i < args.len() {
-        if !allowed.contains(&args[i].as_str()) {
-            return Err(format!("unknown argument `{}`\n{USAGE}", args[i]));
+        let flag = args[i].as_str();
+        if !allowed.contains(&flag) {
+            return Err(format!("unknown argument `{flag}`\n{USAGE}"));
+        }
+        if seen.contains(&flag) {
+            return Err(format!("{flag} is given twice"));
+        }
+        seen.push(flag);
+        match args.get(i + 1) {
+            Some(v) if !v.starts_with("--") => {}
+            _ => return Err(format!("{flag} needs a value")),
         }
         i += 2;
     }
@@ -91,10 +102,7 @@ pub fn spectra(args: Vec<String>) -> Result<(), String> {
     }
     check_flags(&args, &["--band"])?;
     let band = band(&args)?;
-    println!(
-        "spectrum,rms_height_mm,rms_slope_mrad (band {} m to {} m)",
-        band.0, band.1
-    );
+    let mut rows = Vec::new();
     for sp in TrackSpectrum::all() {
         let spec = ProfileSpec {
             spectrum: sp,
@@ -114,12 +122,19 @@ pub fn spectra(args: Vec<String>) -> Result<(), String> {
                 w * w * sp.vertical(w) * w * r / n as f64
             })
             .sum();
-        println!(
+        rows.push(format!(
             "{},{:.2},{:.3}",
             sp.name(),
             1e3 * spec.variance().sqrt(),
             1e3 * slope.sqrt()
-        );
+        ));
+    }
+    println!(
+        "spectrum,rms_height_mm,rms_slope_mrad (band {} m to {} m)",
+        band.0, band.1
+    );
+    for r in rows {
+        println!("{r}");
     }
     let iso = RoughnessSpectrum::iso3095();
     println!("iso3095 roughness limit RMS (um): {:.2}", 1e6 * iso.rms());
@@ -156,13 +171,19 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
         ],
     )?;
     let sp = spectrum(value(&args, "--spectrum").ok_or("--spectrum NAME is needed")?)?;
-    let seed = number(&args, "--seed", 1.0)?;
-    if !(0.0..=u32::MAX as f64).contains(&seed) || seed.fract() != 0.0 {
-        return Err(format!(
-            "--seed {seed}: a whole number from 0 to {}",
-            u32::MAX
-        ));
-    }
+    let seed = match value(&args, "--seed") {
+        None => 1,
+        Some(v) => v
+            .parse::<u32>()
+            .ok()
+            .filter(|&s| s <= i32::MAX as u32)
+            .ok_or_else(|| {
+                format!(
+                    "--seed `{v}`: a whole number from 0 to {} (rail.spectrum.seed's range)",
+                    i32::MAX
+                )
+            })?,
+    };
     let cross_level = match value(&args, "--rails").unwrap_or("independent") {
         "independent" => false,
         "cross_level" => true,
@@ -174,7 +195,7 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
     };
     let spec = ProfileSpec {
         spectrum: sp,
-        seed: seed as u64,
+        seed: u64::from(seed),
         band: band(&args)?,
         cross_level,
         ramp: 1.0,
@@ -193,7 +214,7 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
     let n = (length / dx).round();
     if !(16.0..=1e8).contains(&n) {
         return Err(format!(
-            "--length {length}: 16 to 1e8 samples of --dx {dx} m"
+            "--length {length} and --dx {dx}: 16 to 1e8 samples (length / dx), here {n}"
         ));
     }
     let [l, r] = spec.series();
