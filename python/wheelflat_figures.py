@@ -142,9 +142,13 @@ def study_table(study_file):
     folder's plots {name: path}, the folder, kept until the caller removes it)."""
     sys.path.insert(0, os.path.join(ROOT, "python"))
     from wheelflat_study.spec import load_study
-    from wheelflat_study.run import run_study
+    from wheelflat_study.run import build_runner, run_study
+    from wheelflat_study.__main__ import check_variables
     import shutil
     study = load_study(study_file)
+    # As the command does: the variables checked, enumerations given by item name
+    # turned into their numbers.
+    check_variables(study, build_runner())
     tmp = tempfile.mkdtemp(prefix="figures_")
     try:
         table, _ = run_study(study, tmp, serial=True, progress=False, plots=True, log=lambda *a: None)
@@ -303,6 +307,21 @@ def primary_stiffness_tables(study, ok):
     return {"table": "\n\n" + markdown_table(head, rows) + "\n\n",
             "bearing_fall": f"{fall}, {pct[0]:.0f} to {pct[-1]:.0f} %",
             "contact_rise": f"{100 * min(rises):.0f} to {100 * max(rises):.0f} %"}
+
+
+def track_class_flat_tables(study, ok):
+    """The flat wheel's peak over the seeds, per FRA class, from the study command's own
+    summary (python/wheelflat_study/summary.py), as STUDIES.md quotes it."""
+    from wheelflat_study.summary import percentile_column, summarise
+    rows, pcol = [], percentile_column(study)
+    for r in summarise(study, ok):
+        if r["result"] != "peak.left":
+            continue
+        rows.append([study.shown("rail.spectrum", r["rail.spectrum"]), str(r["count"]),
+                     f"{r['mean'] / 1e3:.1f}", f"{r['std'] / 1e3:.2f}", f"{r[pcol] / 1e3:.1f}",
+                     f"{r['min'] / 1e3:.1f}", f"{r['max'] / 1e3:.1f}"])
+    head = ["track", "seeds", "mean (kN)", "std (kN)", f"{pcol} (kN)", "min (kN)", "max (kN)"]
+    return {"table": "\n\n" + markdown_table(head, rows) + "\n\n"}
 
 
 def source_quickstart():
@@ -638,6 +657,7 @@ SOURCES = {
     "flat_phase": study_source("flat_phase", flat_phase_tables),
     "primary_stiffness": study_source("primary_stiffness", primary_stiffness_tables),
     "receptance": source_receptance,
+    "track_class_flat": study_source("track_class_flat", track_class_flat_tables),
 }
 CHECKING = False
 STALE = []
