@@ -25,8 +25,9 @@ target/release/ (built first if missing):
    carrying the digest of its study's results table, so a plot from an older model is
    found.
 4. The regression kit in regression/ (python/wheelflat_kit.py).
-5. The track's receptance against the independent reference, docs/figures/receptance.png
-   (issue 44; it carries the digest of both curves, as the studies' plots do).
+5. The track's receptance against the independent reference, docs/figures/receptance.png,
+   and the drawn rail profiles against their spectra, docs/figures/track_spectra.png
+   (issue 44; each carries the digest of what it draws, as the studies' plots do).
 
 The stated rounding: a figure is compared as printed, number by number; a number may
 differ from the committed one by one unit in its last printed digit (a rounding
@@ -591,6 +592,7 @@ def source_axle_box_masters():
 
 
 RECEPTANCE_PNG = os.path.join(ROOT, "docs", "figures", "receptance.png")
+SPECTRA_PNG = os.path.join(ROOT, "docs", "figures", "track_spectra.png")
 
 
 def source_receptance():
@@ -640,6 +642,31 @@ def source_receptance():
     return figures
 
 
+def source_spectra():
+    """Issue 44: the drawn rail profiles against their spectra, 20 seeds of each, band by
+    band (python/wheelflat_spectra.py): docs/figures/track_spectra.png, carrying the
+    digest of the estimates as the studies' plots do."""
+    import numpy as np
+    import wheelflat_spectra as ws
+    results = ws.main(["--seeds", "20"])
+    d = ws.digest(results)
+    where = os.path.relpath(SPECTRA_PNG, ROOT)
+    if CHECKING:
+        from PIL import Image, UnidentifiedImageError
+        try:
+            have = Image.open(SPECTRA_PNG).text.get(DIGEST_KEY)
+        except (FileNotFoundError, UnidentifiedImageError, OSError) as e:
+            have = None
+            STALE.append(f"{where}: missing or no PNG ({e}): run python3 python/wheelflat_figures.py")
+        if have is not None and have != d:
+            STALE.append(f"{where}: drawn from other profiles (digest {have}, the current build's {d}): "
+                         "run python3 python/wheelflat_figures.py")
+    else:
+        ws.plot(results, SPECTRA_PNG, metadata={DIGEST_KEY: d})
+    worst = max(float(np.max(np.abs(10 * np.log10(e / t)))) for _, t, e, _ in results.values())
+    return {"spectra.worst_band": f"{worst:.2f} dB"}
+
+
 SOURCES = {
     "regression": source_regression,
     "quickstart": source_quickstart,
@@ -658,6 +685,7 @@ SOURCES = {
     "primary_stiffness": study_source("primary_stiffness", primary_stiffness_tables),
     "receptance": source_receptance,
     "track_class_flat": study_source("track_class_flat", track_class_flat_tables),
+    "spectra": source_spectra,
 }
 CHECKING = False
 STALE = []
