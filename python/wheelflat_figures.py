@@ -626,20 +626,27 @@ def source_receptance():
                 figures[f"receptance.{at}.{kind}.reference"] = f"{r:.1f} Hz"
                 figures[f"receptance.{at}.{kind}.error"] = f"{100 * (m / r - 1):+.2f} %"
     d = hashlib.sha256("\n".join(text).encode()).hexdigest()[:16]
-    where = os.path.relpath(RECEPTANCE_PNG, ROOT)
-    if CHECKING:
-        from PIL import Image, UnidentifiedImageError
-        try:
-            have = Image.open(RECEPTANCE_PNG).text.get(DIGEST_KEY)
-        except (FileNotFoundError, UnidentifiedImageError, OSError) as e:
-            have = None
-            STALE.append(f"{where}: missing or no PNG ({e}): run python3 python/wheelflat_figures.py")
-        if have is not None and have != d:
-            STALE.append(f"{where}: drawn from other receptances (digest {have}, the current build's {d}): "
-                         "run python3 python/wheelflat_figures.py")
-    else:
-        wr.plot_panels(RECEPTANCE_PNG, panels, metadata={DIGEST_KEY: d})
+    digest_png(RECEPTANCE_PNG, d, "receptances", lambda: wr.plot_panels(RECEPTANCE_PNG, panels,
+                                                                          metadata={DIGEST_KEY: d}))
     return figures
+
+
+def digest_png(path, d, what, draw):
+    """A figure that carries the digest `d` of what it draws: checks the committed one's
+    (check mode, naming `what` it was drawn from when it differs) or calls `draw`."""
+    where = os.path.relpath(path, ROOT)
+    if not CHECKING:
+        draw()
+        return
+    from PIL import Image, UnidentifiedImageError
+    try:
+        have = Image.open(path).text.get(DIGEST_KEY)
+    except (FileNotFoundError, UnidentifiedImageError, OSError) as e:
+        STALE.append(f"{where}: missing or no PNG ({e}): run python3 python/wheelflat_figures.py")
+        return
+    if have != d:
+        STALE.append(f"{where}: drawn from other {what} (digest {have}, the current build's {d}): "
+                     "run python3 python/wheelflat_figures.py")
 
 
 def source_spectra():
@@ -650,19 +657,7 @@ def source_spectra():
     import wheelflat_spectra as ws
     results = ws.main(["--seeds", "20"])
     d = ws.digest(results)
-    where = os.path.relpath(SPECTRA_PNG, ROOT)
-    if CHECKING:
-        from PIL import Image, UnidentifiedImageError
-        try:
-            have = Image.open(SPECTRA_PNG).text.get(DIGEST_KEY)
-        except (FileNotFoundError, UnidentifiedImageError, OSError) as e:
-            have = None
-            STALE.append(f"{where}: missing or no PNG ({e}): run python3 python/wheelflat_figures.py")
-        if have is not None and have != d:
-            STALE.append(f"{where}: drawn from other profiles (digest {have}, the current build's {d}): "
-                         "run python3 python/wheelflat_figures.py")
-    else:
-        ws.plot(results, SPECTRA_PNG, metadata={DIGEST_KEY: d})
+    digest_png(SPECTRA_PNG, d, "profiles", lambda: ws.plot(results, SPECTRA_PNG, metadata={DIGEST_KEY: d}))
     worst = max(float(np.max(np.abs(10 * np.log10(e / t)))) for _, t, e, _ in results.values())
     return {"spectra.worst_band": f"{worst:.2f} dB"}
 
