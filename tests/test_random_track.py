@@ -13,9 +13,8 @@ import pytest
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "python"))
 import wheelflat_fmus as wf  # noqa: E402
 
-from fmpy import extract, read_model_description, simulate_fmu  # noqa: E402
+from fmpy import simulate_fmu  # noqa: E402
 from fmpy.fmi1 import FMICallException  # noqa: E402
-from fmpy.fmi2 import FMU2Slave  # noqa: E402
 
 # FRA class 4 (item 5), ISO 3095 roughness on the rails and the wheels.
 RANDOM = {"rail.spectrum": 5, "rail.spectrum.seed": 17, "roughness.rail": "iso3095",
@@ -51,44 +50,26 @@ def test_the_same_seed_draws_the_same_run_and_another_seed_another(coupled):
 
 
 def test_an_fmu_state_carries_the_seeds_into_a_fresh_instance(coupled):
-    md = read_model_description(coupled)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    d = extract(coupled)
-
-    def instance():
-        f = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName="random")
-        f.instantiate()
-        return f
-
-    a = instance()
-    a.setupExperiment(startTime=0.0)
-    for name, value in RANDOM.items():
-        if isinstance(value, str):
-            a.setString([vr[name]], [value])
-        else:
-            a.setInteger([vr[name]], [value])
-    a.setReal([vr["rail.spectrum.shortest_wavelength"], vr["rail.spectrum.longest_wavelength"]], [1.0, 20.0])
-    a.enterInitializationMode()
-    a.exitInitializationMode()
+    a, b = wf.Unit(coupled, "random"), wf.Unit(coupled, "restored")
+    a.fmu.setupExperiment(startTime=0.0)
+    a.set_parameters({**RANDOM, "rail.spectrum.shortest_wavelength": 1.0,
+                      "rail.spectrum.longest_wavelength": 20.0})
+    a.fmu.enterInitializationMode()
+    a.fmu.exitInitializationMode()
     h, t = 1e-3, 0.0
     for _ in range(200):
-        a.doStep(t, h)
+        a.fmu.doStep(t, h)
         t += h
-    blob = a.serializeFMUstate(a.getFMUstate())
-    b = instance()
-    b.setFMUstate(b.deSerializeFMUstate(blob))
-    assert b.getInteger([vr["rail.spectrum.seed"], vr["roughness.seed"]]) == [17, 4]
-    assert b.getReal([vr["rail.spectrum.longest_wavelength"]]) == [20.0]
-    out = [vr["contact.left.force"], vr["contact.right.force"]]
+    b.fmu.setFMUstate(b.fmu.deSerializeFMUstate(a.fmu.serializeFMUstate(a.fmu.getFMUstate())))
+    vr = a.vr
+    assert b.fmu.getInteger([vr["rail.spectrum.seed"], vr["roughness.seed"]]) == [17, 4]
+    assert b.get("rail.spectrum.longest_wavelength") == [20.0]
     for _ in range(200):
-        a.doStep(t, h)
-        b.doStep(t, h)
+        a.fmu.doStep(t, h)
+        b.fmu.doStep(t, h)
         t += h
-        assert a.getReal(out) == b.getReal(out)
-    for f in (a, b):
-        f.terminate()
-        f.freeInstance()
+        assert a.get(*wf.FORCES) == b.get(*wf.FORCES)
+    wf.close_all(a, b)
 
 
 @pytest.mark.parametrize("start, message", [
