@@ -18,6 +18,7 @@ the study's order; each group's swept variables by value, an enumeration by its 
 name; the result's unit in ``unit``) and printed as a table at the end of a run.
 """
 
+import math
 import os
 
 import numpy as np
@@ -70,7 +71,8 @@ def statistics(values, percentile):
 
 def percentile_column(study):
     """The percentile's column: ``p95`` (``p97.5``, ...)."""
-    return f"p{study.summary.percentile:g}"
+    # + 0.0: -0 reads as 0.
+    return f"p{study.summary.percentile + 0.0:g}"
 
 
 def summarise(study, table):
@@ -143,7 +145,8 @@ def format_summary(study, rows, units=None):
         line = [study.shown(n, r[n]) for n in names]
         line += [f"{r['result']} [{unit}]" if unit else r["result"],
                  f"{r['count']}" + (f" of {r['cases']}" if r["cases"] != r["count"] else "")]
-        line += [f"{r[k]:.6g}" for k in ("mean", "std", pcol, "min", "max")]
+        # A statistic there are too few values for (std of one) is blank, as in the CSV.
+        line += ["" if math.isnan(r[k]) else f"{r[k]:.6g}" for k in ("mean", "std", pcol, "min", "max")]
         lines.append(line)
     widths = [max(len(str(line[i])) for line in lines) for i in range(len(head))]
     return "\n".join("  ".join(str(c).ljust(w) if i < len(names) + 1 else str(c).rjust(w)
