@@ -313,3 +313,20 @@ def test_the_track_class_study_makes_a_case_per_class_and_seed_and_summarises_ea
     x = results.loc[results["rail.spectrum"] == results["rail.spectrum"].min(), "peak.left"].to_numpy()
     assert summary["p95"][0] == np.percentile(x, 95) and summary["std"][0] == np.std(x, ddof=1)
     assert (tmp_path / "o" / "track_class_flat_peaks.png").exists()
+
+
+def test_a_group_of_one_case_has_no_standard_deviation_and_prints_it_blank(tmp_path):
+    # One value: its mean, percentile, least and largest are itself; a sample standard
+    # deviation needs two (NaN in the rows, blank in the CSV and the printed table).
+    from wheelflat_study.summary import format_summary, group_names, percentile_column, statistics
+    st = statistics([301.5e3, float("nan")], 90)
+    assert st["count"] == 1 and np.isnan(st["std"])
+    assert st["mean"] == st["percentile"] == st["min"] == st["max"] == 301.5e3
+    path = tmp_path / "dist.toml"
+    path.write_text(SMALL)
+    study = load_study(str(path))
+    row = {n: 100 / 3.6 for n in group_names(study)}
+    row.update({"result": "peak.left", "cases": 2, "count": 1, "mean": st["mean"], "std": st["std"],
+                percentile_column(study): st["percentile"], "min": st["min"], "max": st["max"]})
+    text = format_summary(study, [row])
+    assert "nan" not in text and "1 of 2" in text and "301500" in text, text
