@@ -242,4 +242,3 @@ mod tests {
         assert!((fd - s.at(x).1).abs() < 1e-8 * s.at(x).1.abs().max(1e-3));
     }
 }
-
