@@ -200,8 +200,8 @@ def plot(png, curves, title):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--read", help="a receptance CSV to plot instead of running the runner")
-    ap.add_argument("--at", choices=["sleeper", "midspan"], default="sleeper")
-    ap.add_argument("--rails", choices=["one", "both"], default="one")
+    ap.add_argument("--at", choices=["sleeper", "midspan"], default=None, help="sleeper (default) or midspan")
+    ap.add_argument("--rails", choices=["one", "both"], default=None, help="one (default) or both")
     ap.add_argument("--response", default="point", help="point, other-rail or a distance (m)")
     ap.add_argument("--points", type=int, default=400)
     ap.add_argument("--csv", default=None, help="where the runner's CSV goes (default: beside the PNG)")
@@ -225,6 +225,11 @@ def main(argv=None):
             print(f"fitted {name(fr)}: {fr:.1f} Hz, {mag:.3e} m/N")
         print(f"wrote {os.path.relpath(args.png)}")
         return 0
+    if args.read and args.reference and (args.at is None or args.rails is None):
+        # A CSV does not say where the load was: a reference for another place differs
+        # by up to 20 times.
+        ap.error("--read with --reference needs --at and --rails, those the CSV was made with")
+    args.at, args.rails = args.at or "sleeper", args.rails or "one"
     if args.read:
         f, a = read_csv(args.read)
         title = os.path.basename(args.read)
@@ -233,6 +238,7 @@ def main(argv=None):
         out = run(csv, "--at", args.at, "--rails", args.rails, "--response", args.response, "--points", args.points)
         f, a = read_csv(csv)
         title = out.split("\n")[0]
+        print(f"wrote {os.path.relpath(csv)}")
     curves = [("model (wheelflat receptance)", f, a, "C0-")]
     if args.reference:
         sys.path.insert(0, os.path.join(ROOT, "python"))

@@ -34,9 +34,11 @@ def draw(spectrum, seed, tmp, band=(1.5, 30.0)):
     """The runner's left rail (m) every DX over LENGTH, and its target bands (rows of
     low wavenumber, high wavenumber (rad/m), variance (m^2))."""
     out, target = os.path.join(tmp, "p.csv"), os.path.join(tmp, "t.csv")
-    subprocess.run([RUNNER, "profile", "--spectrum", spectrum, "--seed", str(seed),
-                    "--band", f"{band[0]}:{band[1]}", "--length", str(LENGTH), "--dx", str(DX),
-                    "--output", out, "--target", target], check=True)
+    r = subprocess.run([RUNNER, "profile", "--spectrum", spectrum, "--seed", str(seed),
+                        "--band", f"{band[0]}:{band[1]}", "--length", str(LENGTH), "--dx", str(DX),
+                        "--output", out, "--target", target], capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(f"wheelflat profile --spectrum {spectrum} --seed {seed}: {r.stderr.strip()}")
     x = np.loadtxt(out, delimiter=",", skiprows=1)
     return x[:, 1], np.loadtxt(target, delimiter=",", skiprows=1, ndmin=2)
 
@@ -113,6 +115,7 @@ def main(argv=None):
                   f"integrated spectrum ({1e3 * np.sqrt(target.sum()):.2f} mm)")
     if a.plot:
         plot(results, a.plot)
+        print(f"wrote {a.plot}")
     return results
 
 

@@ -79,6 +79,8 @@ def test_an_fmu_state_carries_the_seeds_into_a_fresh_instance(coupled):
     ({"rail.spectrum": 8, "rail.spectrum.shortest_wavelength": 10.0,
       "rail.spectrum.longest_wavelength": 11.0}, "rail.spectrum.longest_wavelength"),
     ({"roughness.patch_length": 0.2}, "roughness.patch_length"),
+    # A name that is not the ISO limit's is a path; the refusal names the keyword.
+    ({"roughness.rail": "ISO3095"}, "or iso3095 (the ISO 3095 limit)"),
     # A profile at full height at the start would jump under the wheels at the first step.
     ({"rail.spectrum": 2, "rail.spectrum.ramp": 0.0}, "rail.spectrum.ramp"),
     # The Hertz patch the roughness is averaged over needs the Hertz coefficient.

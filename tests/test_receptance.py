@@ -113,8 +113,12 @@ def test_the_fit_recovers_known_pads_and_ballast_and_the_plot_is_written(tmp_pat
                           measured, "--fitted", fitted, "--png", png], capture_output=True, text=True, check=True)
     assert os.path.getsize(png) > 10_000 and "wrote" in out.stdout
     png = str(tmp_path / "receptance.png")
-    out = subprocess.run([sys.executable, os.path.join(ROOT, "python", "wheelflat_receptance.py"), "--read",
-                          clean, "--reference", "--png", png], capture_output=True, text=True, check=True)
+    script = [sys.executable, os.path.join(ROOT, "python", "wheelflat_receptance.py"), "--read", clean,
+              "--reference", "--png", png]
+    # A CSV does not say where its load was: the reference needs it said.
+    out = subprocess.run(script, capture_output=True, text=True)
+    assert out.returncode == 2 and "--read with --reference needs --at and --rails" in out.stderr
+    out = subprocess.run(script + ["--at", "sleeper", "--rails", "one"], capture_output=True, text=True, check=True)
     assert os.path.getsize(png) > 10_000 and "full track" in out.stdout
 
 

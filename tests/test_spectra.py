@@ -44,7 +44,9 @@ def test_the_spectra_table_and_bad_options():
     assert 6.0 < c4 < 7.0
     assert abs(c6 / c4 - np.sqrt(0.0339 / 0.5376)) < 0.01
     for args, word in [(["profile", "--spectrum", "fra_class_9"], "--spectrum"),
-                       (["profile", "--spectrum", "fra_class_4", "--band", "30:1.5"], "longest_wavelength"),
+                       (["profile", "--spectrum", "fra_class_4", "--band", "30:1.5"], "the shortest wavelength first"),
+                       (["profile", "--spectrum", "fra_class_4", "--band", "1.5:1.6"], "longest_wavelength"),
+                       (["spectra", "--band"], "--band needs a value"),
                        (["profile", "--spectrum", "fra_class_4", "--rails", "cross_level"], "rail.spectrum.rails"),
                        (["profile", "--spectrum", "fra_class_4", "--dx", "1"], "--dx"),
                        (["profile", "--spectrum", "ore_low", "--seed", "-3"], "--seed")]:

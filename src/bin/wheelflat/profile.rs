@@ -44,6 +44,9 @@ fn band(args: &[String]) -> Result<(f64, f64), String> {
         Some(v) => {
             let p: Vec<f64> = v.split(':').filter_map(|x| x.parse().ok()).collect();
             match p[..] {
+                [a, b] if a >= b => Err(format!(
+                    "--band `{v}`: SHORTEST:LONGEST, the shortest wavelength first (here {b}:{a}?)"
+                )),
                 [a, b] => Ok((a, b)),
                 _ => Err(format!(
                     "--band `{v}`: expected SHORTEST:LONGEST in metres (1.5:30)"
@@ -231,6 +234,9 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
         writeln!(out, "{x},{:e},{:e}", l.at(x).0, r.at(x).0).map_err(io)?;
     }
     out.flush().map_err(io)?;
+    if let Some(p) = value(&args, "--output") {
+        eprintln!("wrote {p} ({n} samples every {dx} m, both rails, without the ramp)");
+    }
     if let Some(p) = value(&args, "--target") {
         let mut t =
             BufWriter::new(std::fs::File::create(p).map_err(|e| format!("--target {p}: {e}"))?);
@@ -247,6 +253,7 @@ pub fn profile(args: Vec<String>) -> Result<(), String> {
             writeln!(t, "{k0},{k1},{:e}", sp.vertical_variance(k0, k1)).map_err(io)?;
         }
         t.flush().map_err(io)?;
+        eprintln!("wrote {p} ({bands} thirds of an octave)");
     }
     Ok(())
 }

@@ -313,10 +313,16 @@ pub fn table_content(name: &str, text: &str) -> Result<Arc<str>, Error> {
     {
         return Ok(Arc::from(text));
     }
+    // A roughness spectrum may also be named (`iso3095`, as written: lower case).
+    let named = if name.starts_with("roughness.") {
+        format!(", or {ISO_3095_NAME} (the ISO 3095 limit)")
+    } else {
+        String::new()
+    };
     let refuse = |why: String| {
         Error::Table(format!(
             "{name} = {text:?}: {why}; give a path (absolute, or relative to the working \
-             directory) or the table itself (`x y; x y; ...`)"
+             directory) or the table itself (`x y; x y; ...`){named}"
         ))
     };
     // A regular file of at most MAX_TABLE_FILE bytes: not a directory, a device or a
