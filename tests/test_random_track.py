@@ -43,7 +43,8 @@ def test_the_same_seed_draws_the_same_run_and_another_seed_another(coupled):
     # roughness, which is there from the start, the run starts as on ideal rails.
     rails = forces(coupled, **{"rail.spectrum": 5, "rail.spectrum.seed": 17})
     assert np.array_equal(rails[0], ideal[0])
-    assert np.max(np.abs(rails[:3] - ideal[:3])) < 1e-3 * ideal[0, 0]
+    # 1 ms on, 2 cm into the ramp, the profile is a fraction of a micrometre: tens of N.
+    assert np.max(np.abs(rails[:2] - ideal[:2])) < 1e-3 * ideal[0, 0]
     assert np.max(np.abs(rails - ideal)) > 0.01 * ideal[0, 0]
     assert np.max(np.abs(a - c)) > 0.01 * ideal[0, 0]
     assert np.max(np.abs(a - ideal)) > 0.01 * ideal[0, 0]

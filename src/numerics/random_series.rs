@@ -3,21 +3,20 @@
 //! its bands' wavenumbers drawn at random within sub-bands so the sum never repeats.
 
 use super::LANES;
-use rand_chacha::ChaCha8Rng;
-use rand_chacha::rand_core::{RngCore, SeedableRng};
+use rand_core::RngCore;
+use rand_pcg::Pcg64;
 use std::f64::consts::TAU;
 
-/// The pseudo-random numbers of one seeded stream: ChaCha8 (`rand_chacha`, whose output
-/// for a seed and stream is fixed across versions), stream `stream` of seed `seed`, so
-/// that each rail and each wheel draws its own numbers from one seed.
-pub struct Stream(ChaCha8Rng);
+/// The pseudo-random numbers of one seeded stream: PCG64 (`rand_pcg`'s `Lcg128Xsl64`,
+/// whose output for a state and stream is fixed across versions; O'Neill, PCG, 2014),
+/// the seed its state and `stream` its stream (its increment), so that each rail and each
+/// wheel draws its own numbers from one seed.
+pub struct Stream(Pcg64);
 
 impl Stream {
     /// Stream `stream` of seed `seed`.
     pub fn new(seed: u64, stream: u64) -> Self {
-        let mut r = ChaCha8Rng::seed_from_u64(seed);
-        r.set_stream(stream);
-        Stream(r)
+        Stream(Pcg64::new(u128::from(seed), u128::from(stream)))
     }
 
     /// A number uniform in [0, 1), from the top 53 bits of the next word.
