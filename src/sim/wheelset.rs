@@ -112,7 +112,7 @@ impl Wheelset {
     #[inline(always)]
     pub fn radius_deviation(&self, i: usize, gamma: f64) -> f64 {
         self.roundness[i].as_ref().map_or(0.0, |r| r.at(gamma))
-            + self.roughness[i].as_ref().map_or(0.0, |r| r.at(gamma).0)
+            + self.roughness[i].as_ref().map_or(0.0, |r| r.eval(gamma).0)
     }
 
     /// `d/d gamma` of [`Wheelset::radius_deviation`] (m/rad).
@@ -120,7 +120,7 @@ impl Wheelset {
         self.roundness[i]
             .as_ref()
             .map_or(0.0, |r| r.slope_at(gamma))
-            + self.roughness[i].as_ref().map_or(0.0, |r| r.at(gamma).1)
+            + self.roughness[i].as_ref().map_or(0.0, |r| r.eval(gamma).1)
     }
 
     /// The wheels `[left, right]`.

@@ -128,7 +128,7 @@ impl RailProfile {
     }
 
     /// The height (m, up) and its slope `dh/dx` at `x` (m, line coordinates).
-    #[inline(always)]
+    #[inline]
     pub fn at(&self, x: f64) -> (f64, f64) {
         let (mut h, mut s) = self.defect.map_or((0.0, 0.0), |d| d.at(x));
         if let Some(t) = &self.measured {

@@ -311,16 +311,16 @@ impl RandomProfile {
     /// `q^3 (10 - 15 q + 6 q^2)`, `q = (x - start) / ramp`, over the ramp (its slope and
     /// curvature 0 at both ends, so the wheel meets no jump of acceleration), 1 beyond,
     /// 0 before.
-    #[inline(always)]
+    #[inline]
     pub fn at(&self, x: f64) -> (f64, f64) {
         if self.ramp <= 0.0 {
-            return self.series.at(x);
+            return self.series.eval(x);
         }
         let u = x - self.start;
         if u <= 0.0 {
             return (0.0, 0.0);
         }
-        let (h, s) = self.series.at(x);
+        let (h, s) = self.series.eval(x);
         if u >= self.ramp {
             return (h, s);
         }
