@@ -51,9 +51,7 @@ pub use receptance::{
     LoadAt, LoadedRails, RECEPTANCE_FREQUENCY_RANGE, ReceptanceSetup, ResponseAt, log_frequencies,
     track_receptance,
 };
-pub use receptance_fit::{
-    FitOptions, FitParameter, FittedValue, ReceptanceFit, fit_receptance, unit_noise,
-};
+pub use receptance_fit::{FitOptions, FitParameter, FittedValue, ReceptanceFit, fit_receptance};
 pub use spectra::{
     MIN_RAMP, PROFILE_BAND, ProfileSpec, RandomProfile, TERMS_PER_THIRD_OCTAVE, TrackSpectrum,
 };

@@ -32,8 +32,8 @@
 //! as much as plain track does (its module's docs).
 
 use super::*;
+use crate::numerics::dft;
 use nalgebra::Complex;
-use std::f64::consts::TAU;
 
 /// Where the load is applied along the track.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -313,23 +313,6 @@ pub(crate) fn receptance_with_dt(
         .collect())
 }
 
-/// `sum_j x_j e^(-i 2 pi f j dt)` (the samples' own units; no `dt` factor, which
-/// cancels in a ratio), by a rotating phasor renewed every 512 samples.
-pub(crate) fn dft(x: &[f64], dt: f64, f: f64) -> Complex<f64> {
-    let w = TAU * f * dt;
-    let step = Complex::new(w.cos(), -w.sin());
-    let mut sum = Complex::new(0.0, 0.0);
-    for (b, block) in x.chunks(512).enumerate() {
-        let phase = w * (512 * b) as f64;
-        let mut e = Complex::new(phase.cos(), -phase.sin());
-        for &v in block {
-            sum += e * v;
-            e *= step;
-        }
-    }
-    sum
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -354,20 +337,6 @@ mod tests {
         assert!(e.contains("--to"), "{e}");
         let e = log_frequencies(20.0, 3000.0, 1).unwrap_err().to_string();
         assert!(e.contains("--points"), "{e}");
-    }
-
-    #[test]
-    fn the_dft_of_a_pulse_is_its_integral_at_low_frequency() {
-        let x = [0.0, 1.0, 2.0, 1.0];
-        let s = dft(&x, 1e-4, 0.0);
-        assert_eq!((s.re, s.im), (4.0, 0.0));
-        let long: Vec<f64> = (0..2000).map(|j| (j as f64 * 0.37).sin()).collect();
-        let direct: Complex<f64> = long
-            .iter()
-            .enumerate()
-            .map(|(j, v)| Complex::from_polar(*v, -TAU * 800.0 * j as f64 * 1e-5))
-            .sum();
-        assert!((dft(&long, 1e-5, 800.0) - direct).norm() < 1e-9);
     }
 
     #[test]

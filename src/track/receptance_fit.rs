@@ -371,21 +371,6 @@ pub fn fit_receptance(
     })
 }
 
-/// A deterministic pseudo-random sequence (xorshift64*), uniform in [-sqrt 3,
-/// sqrt 3): zero mean, unit variance. For the tests' and the examples' noise.
-pub fn unit_noise(seed: u64, count: usize) -> Vec<f64> {
-    let mut s = seed.max(1);
-    (0..count)
-        .map(|_| {
-            s ^= s >> 12;
-            s ^= s << 25;
-            s ^= s >> 27;
-            let u = (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
-            (2.0 * u - 1.0) * 3f64.sqrt()
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -414,7 +399,12 @@ mod tests {
         };
         let f = log_frequencies(20.0, 3000.0, 40).unwrap();
         let clean = track_receptance(&truth, &options.setup, &f).unwrap();
-        let noise = unit_noise(44, 2 * f.len());
+        // Zero mean, unit variance: uniform in [-sqrt 3, sqrt 3], from the project's
+        // seeded streams.
+        let mut stream = crate::numerics::Stream::new(44, 0);
+        let noise: Vec<f64> = (0..2 * f.len())
+            .map(|_| (2.0 * stream.uniform() - 1.0) * 3f64.sqrt())
+            .collect();
         let measured: Vec<Complex<f64>> = clean
             .iter()
             .enumerate()
